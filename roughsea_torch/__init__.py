@@ -1,0 +1,61 @@
+"""roughsea_torch: physically based infrared radiance of a rough sea, in PyTorch.
+
+The model is the probabilistic facet model of "A probabilistic model of the apparent radiance of a
+rough sea" (the paper's Eqs. 1, 5-10, A7/A8): apparent radiance as a facet-weighted expectation
+over Gaussian wave slopes, with Fresnel emission and reflection of sky radiance and a shadowing
+correction. Conventions: ``docs/physics.md`` of the project (SI units, radians).
+
+Public core::
+
+    import roughsea_torch as rs
+    slopes = rs.SlopeStatistics.cox_munk(wind_speed, anisotropic=False)
+    eps = rs.emissivity(view_zenith, view_azimuth, slopes=slopes, refractive_index=1.218 + 0.0508j)
+    R_a = rs.apparent_radiance(view_zenith, view_azimuth, slopes=slopes, refractive_index=...,
+                               sea_radiance=R_B, sky=lambda cos_zenith: ..., shadowing=True)
+
+``rs.reference`` holds an independent numpy implementation with the same signatures.
+"""
+
+from .expectation import Quadrature, apparent_radiance, emissivity, projected_area, smith_lambda
+from .optics import (
+    band_reflectance,
+    band_refractive_index,
+    fresnel_emissivity,
+    fresnel_reflectance,
+    water_refractive_index,
+)
+from .radiometry import (
+    LWIR,
+    MWIR,
+    SpectralBand,
+    band_radiance,
+    brightness_temperature,
+    planck_radiance,
+)
+from .sky import ConstantSky, TabulatedSky
+from .slopes import SlopeStatistics, slope_pdf
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "LWIR",
+    "MWIR",
+    "ConstantSky",
+    "Quadrature",
+    "SlopeStatistics",
+    "SpectralBand",
+    "TabulatedSky",
+    "apparent_radiance",
+    "band_radiance",
+    "band_reflectance",
+    "band_refractive_index",
+    "brightness_temperature",
+    "emissivity",
+    "fresnel_emissivity",
+    "fresnel_reflectance",
+    "planck_radiance",
+    "projected_area",
+    "slope_pdf",
+    "smith_lambda",
+    "water_refractive_index",
+]

@@ -1,0 +1,100 @@
+"""Input checks shared by the torch modules: dtype/device resolution and named range errors.
+
+Every public function validates its inputs here so that bad input raises a ``ValueError`` that
+names the argument and the allowed range instead of propagating a silent NaN.
+"""
+
+from __future__ import annotations
+
+import math
+from numbers import Number
+from typing import Any
+
+import torch
+
+__all__ = ["resolve_dtype_device", "as_tensor", "check_finite_range", "check_same_device"]
+
+
+def _tensors(items: dict[str, Any]) -> dict[str, torch.Tensor]:
+    return {name: v for name, v in items.items() if isinstance(v, torch.Tensor)}
+
+
+def check_same_device(**items: Any) -> torch.device | None:
+    """Return the common device of the tensor arguments; ``ValueError`` naming them if they differ."""
+    tensors = _tensors(items)
+    devices = {name: t.device for name, t in tensors.items()}
+    unique = set(devices.values())
+    if len(unique) > 1:
+        listing = ", ".join(f"{name} on {dev}" for name, dev in devices.items())
+        raise ValueError(f"mismatched devices: {listing}; move all tensor arguments to one device")
+    return next(iter(unique)) if unique else None
+
+
+def resolve_dtype_device(**items: Any) -> tuple[torch.dtype, torch.device]:
+    """Working dtype and device of a call.
+
+    The dtype is the promotion of the floating (or complex, taken as its real part) tensor
+    arguments; Python numbers do not promote. Without any floating tensor the default dtype
+    (``torch.get_default_dtype()``) is used. Devices must agree.
+    """
+    device = check_same_device(**items)
+    dtype: torch.dtype | None = None
+    for t in _tensors(items).values():
+        d = t.dtype
+        if d.is_complex:
+            d = torch.float64 if d == torch.complex128 else torch.float32
+        elif not d.is_floating_point:
+            continue
+        dtype = d if dtype is None else torch.promote_types(dtype, d)
+    if dtype is None:
+        dtype = torch.get_default_dtype()
+    if dtype not in (torch.float32, torch.float64):
+        raise ValueError(f"unsupported dtype {dtype}: use torch.float32 or torch.float64")
+    return dtype, device if device is not None else torch.device("cpu")
+
+
+def as_tensor(x: Any, dtype: torch.dtype, device: torch.device) -> torch.Tensor:
+    """Tensor of ``dtype`` on ``device`` (keeps the autograd graph of tensor inputs)."""
+    if isinstance(x, torch.Tensor):
+        return x.to(dtype=dtype, device=device)
+    return torch.as_tensor(x, dtype=dtype, device=device)
+
+
+def _values(x: Any) -> torch.Tensor:
+    if isinstance(x, torch.Tensor):
+        return x.detach()
+    return torch.as_tensor(x, dtype=torch.float64)
+
+
+def check_finite_range(
+    name: str,
+    x: Any,
+    lo: float = -math.inf,
+    hi: float = math.inf,
+    *,
+    lo_open: bool = False,
+    hi_open: bool = False,
+    unit: str = "",
+) -> None:
+    """Raise ``ValueError`` naming ``name`` unless every value is a number in the given range."""
+    if x is None:
+        raise ValueError(f"{name} is required")
+    if isinstance(x, Number) and not isinstance(x, bool):
+        vals = torch.tensor([float(x)], dtype=torch.float64)
+    else:
+        vals = _values(x)
+    if vals.is_complex():
+        raise ValueError(f"{name} must be real, got a complex value")
+    if vals.numel() == 0:
+        return
+    bad_nan = torch.isnan(vals).any().item()
+    below = (vals <= lo) if lo_open else (vals < lo)
+    above = (vals >= hi) if hi_open else (vals > hi)
+    if bad_nan or below.any().item() or above.any().item():
+        left = "(" if lo_open else "["
+        right = ")" if hi_open else "]"
+        worst = vals[torch.isnan(vals) | below | above].flatten()[0].item()
+        suffix = f" {unit}" if unit else ""
+        raise ValueError(
+            f"{name} must lie in {left}{lo:g}, {hi:g}{right}{suffix} and not be NaN; got {worst!r}"
+        )

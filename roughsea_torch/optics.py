@@ -1,0 +1,227 @@
+"""Fresnel reflection of a complex refractive index, and the optical constants of water.
+
+Sign convention: m = n + i k with k ≥ 0 for an absorbing medium (``docs/physics.md`` §5). The
+reflectance only depends on |r|², so tables in the n − i k convention give the same ρ once their
+k is taken as positive.
+"""
+
+from __future__ import annotations
+
+import functools
+from importlib import resources
+from typing import Any
+
+import numpy as np
+import torch
+
+from ._validation import as_tensor, check_finite_range, resolve_dtype_device
+from .radiometry import LWIR, as_band, band_weights
+
+__all__ = [
+    "split_refractive_index",
+    "fresnel_reflectance",
+    "fresnel_emissivity",
+    "water_refractive_index",
+    "water_table",
+    "band_refractive_index",
+    "band_reflectance",
+]
+
+WATER_SOURCES = ("hale_querry", "segelstein")
+
+
+def split_refractive_index(
+    refractive_index: Any, dtype: torch.dtype, device: torch.device
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """(n, k) tensors from a Python complex, a complex tensor/array, or an (n, k) pair.
+
+    Raises ``ValueError`` for k < 0, n ≤ 0 or NaN.
+    """
+    if isinstance(refractive_index, (tuple, list)) and len(refractive_index) == 2:
+        n, k = refractive_index
+    elif isinstance(refractive_index, torch.Tensor) and refractive_index.is_complex():
+        n, k = refractive_index.real, refractive_index.imag
+    elif isinstance(refractive_index, np.ndarray) and np.iscomplexobj(refractive_index):
+        n, k = refractive_index.real, refractive_index.imag
+    elif isinstance(refractive_index, (complex, float, int)) or (
+        isinstance(refractive_index, torch.Tensor) and refractive_index.is_floating_point()
+    ):
+        z = refractive_index
+        n, k = (z.real, z.imag) if isinstance(z, complex) else (z, 0.0)
+    else:
+        raise ValueError(
+            "refractive_index must be a complex number, a complex tensor or an (n, k) pair; "
+            f"got {type(refractive_index).__name__}"
+        )
+    check_finite_range("refractive_index (real part n)", n, 0.0, lo_open=True)
+    check_finite_range("refractive_index (imaginary part k)", k, 0.0)
+    return as_tensor(n, dtype, device), as_tensor(k, dtype, device)
+
+
+def _fresnel_terms(
+    c: torch.Tensor, n: torch.Tensor, k: torch.Tensor
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Numerators and denominators of |r_s|² and |r_p|², and of 1 − |r_s|², 1 − |r_p|².
+
+    c = |cos i| ∈ [0, 1]. With m² = M + i N (M = n² − k², N = 2 n k) and
+    √(m² − sin² i) = p + i q (principal root, p ≥ 0, q ≥ 0):
+
+        |r_s|² = ((c − p)² + q²) / ((c + p)² + q²),        1 − |r_s|² = 4 c p / ((c + p)² + q²)
+        |r_p|² = ((M c − p)² + (N c − q)²) / ((M c + p)² + (N c + q)²),
+        1 − |r_p|² = 4 c (M p + N q) / ((M c + p)² + (N c + q)²)
+
+    The second forms give the emissivity 1 − ρ without cancellation near normal incidence.
+    """
+    M = n * n - k * k
+    N = 2.0 * n * k
+    A = M - (1.0 - c * c)  # Re(m² − sin² i)
+    mod = torch.sqrt(A * A + N * N)
+    # Stable complex square root: take the large component from a sum, the other from N / (2·it).
+    pos = A >= 0
+    big = torch.sqrt(0.5 * (mod + A.abs()))
+    big_safe = torch.where(big > 0, big, torch.ones_like(big))
+    small = torch.where(big > 0, N / (2.0 * big_safe), torch.zeros_like(big))
+    p = torch.where(pos, big, small)
+    q = torch.where(pos, small, big)
+    ds = (c + p) ** 2 + q * q
+    Mc, Nc = M * c, N * c
+    dp = (Mc + p) ** 2 + (Nc + q) ** 2
+    rs = ((c - p) ** 2 + q * q) / ds
+    rp = ((Mc - p) ** 2 + (Nc - q) ** 2) / dp
+    es = 4.0 * c * p / ds
+    ep = 4.0 * c * (M * p + N * q) / dp
+    return rs, rp, es, ep
+
+
+def fresnel_reflectance(
+    cos_incidence: Any, refractive_index: Any, polarization: str = "unpolarized"
+) -> torch.Tensor:
+    """Fresnel power reflectance ρ of an air → medium interface (paper: "the Fresnel formula").
+
+    Args:
+        cos_incidence: cos of the angle of incidence, in [-1, 1]; ρ is even in it (|cos| is used).
+        refractive_index: m = n + i k (k ≥ 0) as a complex, a complex tensor or an (n, k) pair.
+        polarization: ``"unpolarized"`` (mean of s and p, the paper's choice), ``"s"`` or ``"p"``.
+
+    Returns:
+        ρ, dimensionless, broadcast over the inputs.
+
+    Example:
+        >>> r0 = fresnel_reflectance(1.0, 1.218 + 0.0508j)
+        >>> round(1 - float(r0), 5)
+        0.98982
+    """
+    check_finite_range("cos_incidence", cos_incidence, -1.0, 1.0)
+    if polarization not in ("unpolarized", "s", "p"):
+        raise ValueError(f"polarization must be 'unpolarized', 's' or 'p'; got {polarization!r}")
+    dtype, device = resolve_dtype_device(cos_incidence=cos_incidence, refractive_index=refractive_index)
+    c = as_tensor(cos_incidence, dtype, device).abs()
+    n, k = split_refractive_index(refractive_index, dtype, device)
+    rs, rp, _, _ = _fresnel_terms(c, n, k)
+    if polarization == "s":
+        return rs
+    if polarization == "p":
+        return rp
+    return 0.5 * (rs + rp)
+
+
+def fresnel_emissivity(cos_incidence: Any, refractive_index: Any) -> torch.Tensor:
+    """Facet emissivity 1 − ρ (Kirchhoff), computed without cancellation [dimensionless]."""
+    check_finite_range("cos_incidence", cos_incidence, -1.0, 1.0)
+    dtype, device = resolve_dtype_device(cos_incidence=cos_incidence, refractive_index=refractive_index)
+    c = as_tensor(cos_incidence, dtype, device).abs()
+    n, k = split_refractive_index(refractive_index, dtype, device)
+    _, _, es, ep = _fresnel_terms(c, n, k)
+    return 0.5 * (es + ep)
+
+
+# -- optical constants of water --------------------------------------------------------------
+
+
+@functools.lru_cache(maxsize=4)
+def water_table(source: str = "hale_querry") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The shipped table (wavelength [m], n, k) of liquid water at 25 °C.
+
+    Sources (refractiveindex.info database, CC0; generated by ``pipelines/make_water_table.py``):
+    ``"hale_querry"`` — Hale & Querry 1973, Appl. Opt. 12, 555 (default; the paper's era);
+    ``"segelstein"`` — Segelstein 1981, finer sampling, same group.
+    """
+    if source not in WATER_SOURCES:
+        raise ValueError(f"source must be one of {WATER_SOURCES}; got {source!r}")
+    text = resources.files("roughsea_torch").joinpath("data", f"water_{source}.csv").read_text()
+    rows = [ln for ln in text.splitlines() if ln and not ln.startswith("#")][1:]
+    arr = np.array([[float(v) for v in ln.split(",")] for ln in rows])
+    return arr[:, 0] * 1e-6, arr[:, 1], arr[:, 2]
+
+
+def water_refractive_index(wavelength: Any, source: str = "hale_querry") -> torch.Tensor:
+    """Complex refractive index n + i k of liquid water, linear interpolation in wavelength.
+
+    Args:
+        wavelength: λ [m], within the shipped table (about 2.5–15 µm).
+        source: ``"hale_querry"`` (default) or ``"segelstein"``.
+
+    Returns:
+        complex tensor (complex64 for float32 input, else complex128), shape of ``wavelength``.
+    """
+    wl, n, k = water_table(source)
+    check_finite_range("wavelength", wavelength, float(wl[0]), float(wl[-1]), unit="m")
+    dtype, device = resolve_dtype_device(wavelength=wavelength)
+    lam = as_tensor(wavelength, dtype, device)
+    wl_t = torch.as_tensor(wl, dtype=dtype, device=device)
+    nk = torch.as_tensor(np.stack([n, k]), dtype=dtype, device=device)
+    i = torch.searchsorted(wl_t, lam.detach().contiguous(), right=True).clamp(1, wl.size - 1)
+    x0, x1 = wl_t[i - 1], wl_t[i]
+    f = (lam - x0) / (x1 - x0)
+    out = nk[:, i - 1] * (1.0 - f) + nk[:, i] * f
+    return torch.complex(out[0], out[1])
+
+
+def band_refractive_index(
+    band: Any = LWIR, temperature: Any = 300.0, response: Any = None, source: str = "hale_querry"
+) -> torch.Tensor:
+    """Band-effective index: n and k averaged with weights B_λ(T) · response(λ) (the paper's choice).
+
+    Args:
+        band: (λ_lo, λ_hi) [m] or a ``SpectralBand``.
+        temperature: T [K] of the Planck weight (the sea temperature); float or tensor.
+        response: relative spectral response; None = flat.
+
+    Returns:
+        complex tensor n̄ + i k̄ of the shape of ``temperature``.
+
+    Notes:
+        Averaging n and k is what the paper does ("an average weighted by the response function").
+        ``docs/physics.md`` §5 recommends averaging the reflectance instead; see
+        :func:`band_reflectance` and ``pipelines/band_averaging.py`` for the measured difference.
+    """
+    b = as_band(band, response)
+    dtype, device = resolve_dtype_device(temperature=temperature)
+    lam, w = band_weights(b, temperature, dtype, device)
+    m = water_refractive_index(lam, source)
+    return (m * w.to(m.dtype)).sum(-1)
+
+
+def band_reflectance(
+    cos_incidence: Any,
+    band: Any = LWIR,
+    temperature: Any = 300.0,
+    response: Any = None,
+    source: str = "hale_querry",
+) -> torch.Tensor:
+    """Band-averaged Fresnel reflectance ρ̄ = Σ w(λ) ρ(cos i; m(λ)), w ∝ B_λ(T) · response.
+
+    Args:
+        cos_incidence: cos of the incidence angle; a float or tensor of shape S.
+        temperature: T [K] for the Planck weight; float or tensor broadcastable with S.
+
+    Returns:
+        ρ̄ of the broadcast shape.
+    """
+    b = as_band(band, response)
+    dtype, device = resolve_dtype_device(cos_incidence=cos_incidence, temperature=temperature)
+    lam, w = band_weights(b, temperature, dtype, device)
+    m = water_refractive_index(lam, source)
+    c = as_tensor(cos_incidence, dtype, device).abs().unsqueeze(-1)
+    rs, rp, _, _ = _fresnel_terms(c, m.real.to(dtype), m.imag.to(dtype))
+    return (0.5 * (rs + rp) * w).sum(-1)

@@ -1,0 +1,245 @@
+"""Planck radiance, sensor bands, band radiance and its inverse (brightness temperature).
+
+Units (``docs/physics.md`` §2): wavelength in metres, temperature in kelvin, spectral radiance in
+W m⁻² sr⁻¹ m⁻¹, band radiance in W m⁻² sr⁻¹. Constants are the exact CODATA 2018 values.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+import torch
+
+from ._validation import as_tensor, check_finite_range, resolve_dtype_device
+
+__all__ = [
+    "PLANCK_H",
+    "SPEED_OF_LIGHT",
+    "BOLTZMANN_K",
+    "LWIR",
+    "MWIR",
+    "SpectralBand",
+    "planck_radiance",
+    "band_radiance",
+    "brightness_temperature",
+]
+
+PLANCK_H = 6.62607015e-34  # J s
+SPEED_OF_LIGHT = 299792458.0  # m s⁻¹
+BOLTZMANN_K = 1.380649e-23  # J K⁻¹
+_C1 = 2.0 * PLANCK_H * SPEED_OF_LIGHT**2  # W m² sr⁻¹ (first radiation constant, per sr)
+_C2 = PLANCK_H * SPEED_OF_LIGHT / BOLTZMANN_K  # m K (second radiation constant)
+
+LWIR = (8e-6, 12e-6)
+MWIR = (3e-6, 5e-6)
+
+
+def planck_radiance(wavelength: Any, temperature: Any) -> torch.Tensor:
+    """Blackbody spectral radiance B_λ(T) [W m⁻² sr⁻¹ m⁻¹].
+
+    Args:
+        wavelength: λ [m], > 0.
+        temperature: T [K], > 0.
+
+    B_λ = 2 h c² λ⁻⁵ / (exp(h c / (λ k T)) − 1); ``expm1`` keeps the long-wavelength end accurate.
+    """
+    check_finite_range("wavelength", wavelength, 0.0, lo_open=True, unit="m")
+    check_finite_range("temperature", temperature, 0.0, lo_open=True, unit="K")
+    dtype, device = resolve_dtype_device(wavelength=wavelength, temperature=temperature)
+    lam = as_tensor(wavelength, dtype, device)
+    t = as_tensor(temperature, dtype, device)
+    return _planck(lam, t)
+
+
+def _planck(lam: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
+    # Scale to micrometres inside so float32 never sees λ⁻⁵ ~ 1e30.
+    lam_um = lam * 1e6
+    x = (_C2 * 1e6) / (lam_um * t)
+    return (_C1 * 1e24 * 1e6) / (lam_um**5 * torch.expm1(x))
+
+
+def _planck_dT(lam: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
+    """∂B_λ/∂T [W m⁻² sr⁻¹ m⁻¹ K⁻¹]."""
+    lam_um = lam * 1e6
+    x = (_C2 * 1e6) / (lam_um * t)
+    em1 = torch.expm1(x)
+    b = (_C1 * 1e24 * 1e6) / (lam_um**5 * em1)
+    return b * x / t * (em1 + 1.0) / em1
+
+
+@dataclass(frozen=True)
+class SpectralBand:
+    """A sensor band: wavelength limits [m] and an optional relative spectral response.
+
+    Args:
+        lo, hi: band limits λ_lo < λ_hi [m].
+        response: None (flat, 1), a callable of wavelength [m] (numpy array in, numpy array out),
+            or a pair (wavelength [m], response) of 1-d arrays interpolated linearly, 0 outside.
+        nodes_per_panel: Gauss–Legendre nodes per panel; the band is split into panels at the
+            nodes of a tabulated response so that its kinks sit at panel edges.
+
+    The quadrature (``nodes``, ``weights``) integrates ∫ r(λ) f(λ) dλ as Σ wᵢ f(λᵢ): the response
+    is folded into the weights.
+    """
+
+    lo: float
+    hi: float
+    response: Any = None
+    nodes_per_panel: int = 24
+
+    def __post_init__(self) -> None:
+        check_finite_range("band[0]", self.lo, 0.0, lo_open=True, unit="m")
+        check_finite_range("band[1]", self.hi, 0.0, lo_open=True, unit="m")
+        if not self.hi > self.lo:
+            raise ValueError(f"band: need lo < hi, got ({self.lo!r}, {self.hi!r}) m")
+        if self.lo < 1e-7 or self.hi > 1e-3:
+            raise ValueError(
+                f"band: limits must be wavelengths in metres within [1e-7, 1e-3]; got ({self.lo!r}, {self.hi!r}). "
+                "Did you pass micrometres?"
+            )
+
+    @property
+    def quadrature(self) -> tuple[np.ndarray, np.ndarray]:
+        return _band_quadrature(self)
+
+    def nodes(self, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, torch.Tensor]:
+        lam, w = self.quadrature
+        return (
+            torch.as_tensor(lam, dtype=dtype, device=device),
+            torch.as_tensor(w, dtype=dtype, device=device),
+        )
+
+    def __hash__(self) -> int:  # responses given as arrays are not hashable themselves
+        return hash((self.lo, self.hi, id(self.response), self.nodes_per_panel))
+
+
+_band_cache: dict[int, tuple[SpectralBand, tuple[np.ndarray, np.ndarray]]] = {}
+
+
+def _band_quadrature(band: SpectralBand) -> tuple[np.ndarray, np.ndarray]:
+    key = hash(band)
+    hit = _band_cache.get(key)
+    if hit is not None and hit[0] is band:
+        return hit[1]
+    edges = [band.lo, band.hi]
+    resp = band.response
+    table = None
+    if resp is not None and not callable(resp):
+        wl, rv = (np.asarray(a, dtype=np.float64) for a in resp)
+        if wl.ndim != 1 or wl.shape != rv.shape or wl.size < 2 or np.any(np.diff(wl) <= 0):
+            raise ValueError("response: a table must be two 1-d arrays (wavelength ascending [m], response)")
+        if np.any(rv < 0) or not np.all(np.isfinite(rv)):
+            raise ValueError("response: values must be finite and ≥ 0")
+        table = (wl, rv)
+        inner = wl[(wl > band.lo) & (wl < band.hi)]
+        edges = sorted(set([band.lo, band.hi, *inner.tolist()]))
+    x, w = _gauss_legendre(band.nodes_per_panel)
+    lams, weights = [], []
+    for a, b in zip(edges[:-1], edges[1:]):
+        lams.append(0.5 * (a + b) + 0.5 * (b - a) * x)
+        weights.append(0.5 * (b - a) * w)
+    lam = np.concatenate(lams)
+    wt = np.concatenate(weights)
+    if table is not None:
+        wt = wt * np.interp(lam, table[0], table[1], left=0.0, right=0.0)
+    elif callable(resp):
+        r = np.asarray(resp(lam), dtype=np.float64)
+        if r.shape != lam.shape or np.any(r < 0) or not np.all(np.isfinite(r)):
+            raise ValueError("response: the callable must return finite values ≥ 0 of its input's shape")
+        wt = wt * r
+    if not np.any(wt > 0):
+        raise ValueError("response: it is zero over the whole band")
+    _band_cache[key] = (band, (lam, wt))
+    return lam, wt
+
+
+@lru_cache(maxsize=64)
+def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    return np.polynomial.legendre.leggauss(n)
+
+
+def as_band(band: Any, response: Any = None) -> SpectralBand:
+    """A :class:`SpectralBand` from a band object or a (λ_lo, λ_hi) pair [m]."""
+    if isinstance(band, SpectralBand):
+        if response is not None:
+            return SpectralBand(band.lo, band.hi, response, band.nodes_per_panel)
+        return band
+    try:
+        lo, hi = band
+    except (TypeError, ValueError):
+        raise ValueError(f"band must be a (lambda_lo, lambda_hi) pair in metres or a SpectralBand, got {band!r}")
+    return SpectralBand(float(lo), float(hi), response)
+
+
+def band_radiance(temperature: Any, band: Any = LWIR, response: Any = None) -> torch.Tensor:
+    """Blackbody band radiance L(T) = ∫ r(λ) B_λ(T) dλ over the band [W m⁻² sr⁻¹].
+
+    Args:
+        temperature: T [K] > 0, float or tensor of any shape.
+        band: (λ_lo, λ_hi) [m] or a :class:`SpectralBand`.
+        response: relative spectral response (see :class:`SpectralBand`); None = 1.
+    """
+    check_finite_range("temperature", temperature, 0.0, lo_open=True, unit="K")
+    b = as_band(band, response)
+    dtype, device = resolve_dtype_device(temperature=temperature)
+    t = as_tensor(temperature, dtype, device)
+    lam, w = b.nodes(dtype, device)
+    return (_planck(lam, t.unsqueeze(-1)) * w).sum(-1)
+
+
+class _BrightnessTemperature(torch.autograd.Function):
+    """Inverse of the band radiance; backward by the implicit-function theorem dT/dL = 1/(dL/dT)."""
+
+    @staticmethod
+    def forward(ctx, radiance, lam, w):  # type: ignore[override]
+        L = radiance.double()
+        lam64, w64 = lam.double(), w.double()
+        # Initial guess: invert Planck at the response-weighted mean wavelength, then Newton.
+        lam_c = (lam64 * w64).sum() / w64.sum()
+        width = w64.sum()
+        Bc = (L / width).clamp_min(1e-300)
+        lam_um = lam_c * 1e6
+        t = (_C2 * 1e6) / (lam_um * torch.log1p((_C1 * 1e30) / (lam_um**5 * Bc)))
+        for _ in range(50):
+            f = (_planck(lam64, t.unsqueeze(-1)) * w64).sum(-1) - L
+            df = (_planck_dT(lam64, t.unsqueeze(-1)) * w64).sum(-1)
+            step = f / df
+            t = (t - step).clamp_min(1.0)
+            if bool((step.abs() <= 1e-13 * t).all()):
+                break
+        t = t.to(radiance.dtype)
+        ctx.save_for_backward(t, lam, w)
+        return t
+
+    @staticmethod
+    def backward(ctx, grad):  # type: ignore[override]
+        t, lam, w = ctx.saved_tensors
+        dLdT = (_planck_dT(lam, t.unsqueeze(-1)) * w).sum(-1)
+        return grad / dLdT, None, None
+
+
+def brightness_temperature(radiance: Any, band: Any = LWIR, response: Any = None) -> torch.Tensor:
+    """Temperature [K] of the blackbody whose band radiance equals ``radiance`` [W m⁻² sr⁻¹].
+
+    Inverse of :func:`band_radiance` (Newton iterations in float64, returned in the input's
+    dtype); differentiable, with dT/dL = 1 / (dL/dT).
+    """
+    check_finite_range("radiance", radiance, 0.0, lo_open=True, unit="W m-2 sr-1")
+    b = as_band(band, response)
+    dtype, device = resolve_dtype_device(radiance=radiance)
+    L = as_tensor(radiance, dtype, device)
+    lam, w = b.nodes(dtype, device)
+    return _BrightnessTemperature.apply(L, lam, w)
+
+
+def band_weights(
+    band: SpectralBand, temperature: Any, dtype: torch.dtype, device: torch.device
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Wavelength nodes [m] and normalized Planck × response weights (sum 1 along the last axis)."""
+    lam, w = band.nodes(dtype, device)
+    t = as_tensor(temperature, dtype, device).unsqueeze(-1)
+    ww = _planck(lam, t) * w
+    return lam, ww / ww.sum(-1, keepdim=True)

@@ -1,0 +1,183 @@
+"""Downwelling sky radiance R_s as a function of the zenith angle of the reflected ray (Eq. 10).
+
+Three forms are accepted wherever a ``sky`` argument appears:
+
+- a callable ``f(cos_zenith) -> radiance`` (elementwise, shape preserving) [W m⁻² sr⁻¹];
+- a table: a :class:`TabulatedSky`, or a pair ``(zenith [rad], radiance)`` of 1-d arrays/tensors;
+- a constant: a float, or a tensor broadcastable against the batch of view directions.
+
+Named atmospheres (LOWTRAN7 tables) come from :func:`roughsea_torch.atmosphere.load_sky`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable
+
+import numpy as np
+import torch
+
+__all__ = ["TabulatedSky", "ConstantSky", "as_sky", "pchip_derivatives"]
+
+
+def pchip_derivatives(x: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
+    """Node derivatives of the monotone piecewise-cubic Hermite interpolant (Fritsch–Butland).
+
+    The same rule as ``scipy.interpolate.PchipInterpolator``: weighted harmonic mean of the
+    neighbouring secant slopes inside, zero at local extrema, the non-centred three-point
+    formula (limited to keep monotonicity) at the ends. ``y`` may carry leading batch dims.
+    """
+    h = x[1:] - x[:-1]
+    m = (y[..., 1:] - y[..., :-1]) / h
+    if x.numel() == 2:
+        return torch.cat([m, m], dim=-1)
+    m0, m1 = m[..., :-1], m[..., 1:]
+    w1 = 2.0 * h[1:] + h[:-1]
+    w2 = h[1:] + 2.0 * h[:-1]
+    same = (torch.sign(m0) == torch.sign(m1)) & (m0 != 0) & (m1 != 0)
+    m0s = torch.where(same, m0, torch.ones_like(m0))
+    m1s = torch.where(same, m1, torch.ones_like(m1))
+    inner = torch.where(same, (w1 + w2) / (w1 / m0s + w2 / m1s), torch.zeros_like(m0))
+
+    def edge(h0, h1, ma, mb):
+        d = ((2.0 * h0 + h1) * ma - h0 * mb) / (h0 + h1)
+        d = torch.where(torch.sign(d) != torch.sign(ma), torch.zeros_like(d), d)
+        clip = (torch.sign(ma) != torch.sign(mb)) & (d.abs() > 3.0 * ma.abs())
+        return torch.where(clip, 3.0 * ma, d)
+
+    d_first = edge(h[0], h[1], m[..., :1], m[..., 1:2])
+    d_last = edge(h[-1], h[-2], m[..., -1:], m[..., -2:-1])
+    return torch.cat([d_first, inner, d_last], dim=-1)
+
+
+class TabulatedSky:
+    """Sky radiance tabulated over zenith angle, interpolated by PCHIP in the zenith angle.
+
+    Args:
+        zenith: (Nz,) zenith angles [rad], strictly ascending, within [0, π/2].
+        radiance: (..., Nz) band radiance [W m⁻² sr⁻¹]; leading dims (one table per sea state)
+            broadcast against the leading (batch) dims of the query.
+
+    Calling it with ``cos_zenith`` interpolates; outside the table range the end values are held.
+    With a batched table the query must have shape (*batch, N): the last dim runs over
+    directions of one batch element. The interpolant is C¹ and monotone where the data are
+    (``scipy.interpolate.PchipInterpolator`` gives the same curve), so it never invents the
+    overshoot a cubic spline adds next to the steep rise at the horizon.
+
+    Example:
+        >>> sky = TabulatedSky(torch.tensor([0.0, 1.0, 1.5707963]), torch.tensor([11.0, 14.0, 40.0]))
+        >>> float(sky(torch.tensor(1.0)))
+        11.0
+    """
+
+    def __init__(self, zenith: Any, radiance: Any):
+        z = torch.as_tensor(zenith)
+        r = torch.as_tensor(radiance)
+        if not z.is_floating_point():
+            z = z.double()
+        if not r.is_floating_point():
+            r = r.to(z.dtype)
+        if z.ndim != 1 or z.numel() < 2:
+            raise ValueError(f"zenith must be a 1-d table of at least 2 angles; got shape {tuple(z.shape)}")
+        if r.shape[-1] != z.numel():
+            raise ValueError(
+                f"radiance must have the table size {z.numel()} as its last dim; got shape {tuple(r.shape)}"
+            )
+        zd = z.detach()
+        if torch.isnan(zd).any() or (zd[1:] <= zd[:-1]).any() or zd[0] < 0 or zd[-1] > math.pi / 2 + 1e-6:
+            raise ValueError("zenith must be strictly ascending within [0, pi/2] rad")
+        if torch.isnan(r.detach()).any() or (r.detach() < 0).any():
+            raise ValueError("radiance must be finite and >= 0 (W m-2 sr-1)")
+        self.zenith = z
+        self.radiance = r
+        self._cache: dict[tuple[torch.dtype, torch.device], tuple[torch.Tensor, ...]] = {}
+
+    def _tables(self, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, ...]:
+        key = (dtype, device)
+        if self.radiance.requires_grad or key not in self._cache:
+            z = self.zenith.to(dtype=dtype, device=device)
+            r = self.radiance.to(dtype=dtype, device=device)
+            d = pchip_derivatives(z, r)
+            out = (z, r, d)
+            if self.radiance.requires_grad:
+                return out
+            self._cache[key] = out
+        return self._cache[key]
+
+    def __call__(self, cos_zenith: torch.Tensor) -> torch.Tensor:
+        cz = cos_zenith
+        z, r, d = self._tables(cz.dtype, cz.device)
+        # acos has an infinite slope at cos = 1: hold the query a rounding step away from it.
+        one = 1.0 - torch.finfo(cz.dtype).eps
+        theta = torch.acos(cz.clamp(0.0, one))
+        theta = torch.minimum(torch.maximum(theta, z[0]), z[-1])
+        i = torch.searchsorted(z, theta.detach().contiguous(), right=True).clamp(1, z.numel() - 1) - 1
+        x0, x1 = z[i], z[i + 1]
+        h = x1 - x0
+        t = (theta - x0) / h
+        if r.ndim == 1:
+            y0, y1, d0, d1 = r[i], r[i + 1], d[i], d[i + 1]
+        else:
+            lead = torch.broadcast_shapes(r.shape[:-1], i.shape[:-1])
+            rb = r.expand(*lead, r.shape[-1])
+            db = d.expand(*lead, d.shape[-1])
+            ib = i.expand(*lead, i.shape[-1])
+            y0, y1 = rb.gather(-1, ib), rb.gather(-1, ib + 1)
+            d0, d1 = db.gather(-1, ib), db.gather(-1, ib + 1)
+        t2 = t * t
+        t3 = t2 * t
+        h00 = 2 * t3 - 3 * t2 + 1
+        h10 = t3 - 2 * t2 + t
+        h01 = -2 * t3 + 3 * t2
+        h11 = t3 - t2
+        return h00 * y0 + h10 * h * d0 + h01 * y1 + h11 * h * d1
+
+    def with_radiance(self, radiance: torch.Tensor) -> TabulatedSky:
+        """The same zenith nodes with other (already validated) radiance rows."""
+        out = TabulatedSky.__new__(TabulatedSky)
+        out.zenith, out.radiance, out._cache = self.zenith, radiance, {}
+        return out
+
+    def __repr__(self) -> str:
+        return f"TabulatedSky(n_zenith={self.zenith.numel()}, batch={tuple(self.radiance.shape[:-1])})"
+
+
+class ConstantSky:
+    """Sky radiance independent of direction [W m⁻² sr⁻¹]; a float or a per-sea-state tensor."""
+
+    def __init__(self, radiance: Any):
+        self.radiance = radiance
+
+    def __call__(self, cos_zenith: torch.Tensor) -> torch.Tensor:
+        r = torch.as_tensor(self.radiance, dtype=cos_zenith.dtype, device=cos_zenith.device)
+        if r.ndim:
+            r = r.unsqueeze(-1)
+        return r.expand(torch.broadcast_shapes(r.shape, cos_zenith.shape))
+
+    def __repr__(self) -> str:
+        return f"ConstantSky({self.radiance!r})"
+
+
+SkyLike = Callable[[torch.Tensor], torch.Tensor] | TabulatedSky | ConstantSky | float | tuple
+
+
+def as_sky(sky: Any) -> Callable[[torch.Tensor], torch.Tensor]:
+    """Normalize any accepted ``sky`` form to a callable of cos(zenith)."""
+    if sky is None:
+        raise ValueError("sky is required: a callable of cos(zenith), a (zenith, radiance) table or a constant")
+    if isinstance(sky, str):
+        from .atmosphere import load_sky  # named LOWTRAN atmosphere, default band
+
+        return load_sky(sky)
+    if isinstance(sky, (TabulatedSky, ConstantSky)):
+        return sky
+    if isinstance(sky, (tuple, list)) and len(sky) == 2:
+        return TabulatedSky(*sky)
+    if isinstance(sky, (int, float)) or isinstance(sky, (torch.Tensor, np.ndarray)):
+        val = torch.as_tensor(sky)
+        if torch.isnan(val).any() or (val < 0).any():
+            raise ValueError("sky: a constant sky radiance must be finite and >= 0 (W m-2 sr-1)")
+        return ConstantSky(sky)
+    if callable(sky):
+        return sky
+    raise ValueError(f"sky: unsupported type {type(sky).__name__}")

@@ -1,0 +1,175 @@
+"""Gaussian wave-slope statistics (paper Eq. 1, A7/A8) and the Cox–Munk wind laws (Eq. 12).
+
+Convention (``docs/physics.md`` §2): slope axes x_s = upwind, y_s = crosswind (x_s rotated by
++90°). Slope components (s_x, s_y) = tan θ (cos φ, sin φ) ~ N(0, Σ) with
+Σ = [[a², r a b], [r a b, b²]]; a, b are the upwind/crosswind rms slopes, r their correlation.
+
+Internally the statistics are held as the variances and the covariance (a², b², r a b). The model
+depends smoothly on Σ, while a = √(a²) is not differentiable at a = 0 (anisotropic Cox–Munk at
+zero wind has a = 0): keeping Σ keeps gradients with respect to wind speed finite there.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import torch
+
+from ._validation import as_tensor, check_finite_range, resolve_dtype_device
+
+__all__ = ["SlopeStatistics", "slope_pdf"]
+
+Number = float | int
+
+
+class SlopeStatistics:
+    """Zero-mean Gaussian slope statistics of the sea surface.
+
+    Args:
+        std_upwind: a, rms slope along the upwind axis [dimensionless, ≥ 0]; float or tensor.
+        std_crosswind: b, rms slope along the crosswind axis [dimensionless, ≥ 0].
+        corr: r, correlation of the two slope components [dimensionless, |r| < 1].
+
+    Values may be floats or tensors of any broadcastable shape (one value per sea state);
+    gradients flow to tensor inputs. Build from a wind speed with :meth:`cox_munk`.
+
+    Example:
+        >>> s = SlopeStatistics.cox_munk(10.0)
+        >>> round(float(s.mean_square_slope), 4)
+        0.0542
+    """
+
+    def __init__(self, std_upwind: Any, std_crosswind: Any, corr: Any = 0.0):
+        check_finite_range("std_upwind", std_upwind, 0.0)
+        check_finite_range("std_crosswind", std_crosswind, 0.0)
+        check_finite_range("corr", corr, -1.0, 1.0, lo_open=True, hi_open=True)
+        self._init_variances(
+            _square(std_upwind), _square(std_crosswind), _mul3(corr, std_upwind, std_crosswind)
+        )
+
+    def _init_variances(self, var_upwind: Any, var_crosswind: Any, cov: Any) -> None:
+        self.var_upwind = var_upwind
+        self.var_crosswind = var_crosswind
+        self.cov = cov
+
+    @classmethod
+    def from_variances(cls, var_upwind: Any, var_crosswind: Any, cov: Any = 0.0) -> SlopeStatistics:
+        """Build from a², b² and the covariance r a b (the form the model uses internally)."""
+        check_finite_range("var_upwind", var_upwind, 0.0)
+        check_finite_range("var_crosswind", var_crosswind, 0.0)
+        check_finite_range("cov", cov)
+        obj = cls.__new__(cls)
+        obj._init_variances(var_upwind, var_crosswind, cov)
+        det = _values(var_upwind) * _values(var_crosswind) - _values(cov) ** 2
+        if (det < 0).any():
+            raise ValueError("cov: the covariance must satisfy cov² ≤ var_upwind · var_crosswind")
+        return obj
+
+    @classmethod
+    def isotropic(cls, mean_square_slope: Any) -> SlopeStatistics:
+        """Isotropic slopes with total mean-square slope σ² = a² + b² (a² = b² = σ²/2)."""
+        check_finite_range("mean_square_slope", mean_square_slope, 0.0)
+        half = mean_square_slope * 0.5
+        return cls.from_variances(half, half, 0.0)
+
+    @classmethod
+    def cox_munk(cls, wind_speed: Any, anisotropic: bool = False) -> SlopeStatistics:
+        """Cox & Munk (1954) clean-surface slope laws for a wind speed W [m s⁻¹] at 12.5 m.
+
+        - isotropic (the paper's Eq. 12): σ² = 0.003 + 5.12·10⁻³ W, a² = b² = σ²/2;
+        - anisotropic: upwind a² = 3.16·10⁻³ W, crosswind b² = 0.003 + 1.92·10⁻³ W, r = 0.
+
+        W = 0 is not a flat sea (σ² = 0.003); a flat sea is ``SlopeStatistics(0, 0)``.
+        """
+        check_finite_range("wind_speed", wind_speed, 0.0, unit="m/s")
+        if anisotropic:
+            return cls.from_variances(3.16e-3 * wind_speed, 0.003 + 1.92e-3 * wind_speed, 0.0)
+        return cls.isotropic(0.003 + 5.12e-3 * wind_speed)
+
+    # -- derived quantities -------------------------------------------------------------------
+    @property
+    def std_upwind(self) -> Any:
+        return _sqrt(self.var_upwind)
+
+    @property
+    def std_crosswind(self) -> Any:
+        return _sqrt(self.var_crosswind)
+
+    @property
+    def corr(self) -> Any:
+        denom = _sqrt(self.var_upwind * self.var_crosswind)
+        if isinstance(denom, torch.Tensor):
+            return torch.where(denom > 0, self.cov / torch.where(denom > 0, denom, 1.0), 0.0)
+        return self.cov / denom if denom > 0 else 0.0
+
+    @property
+    def mean_square_slope(self) -> Any:
+        """Total mean-square slope σ² = a² + b² [dimensionless]."""
+        return self.var_upwind + self.var_crosswind
+
+    def tensors(
+        self, dtype: torch.dtype, device: torch.device
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """(a², b², r a b) as tensors of ``dtype`` on ``device``."""
+        return (
+            as_tensor(self.var_upwind, dtype, device),
+            as_tensor(self.var_crosswind, dtype, device),
+            as_tensor(self.cov, dtype, device),
+        )
+
+    def parameters_dict(self) -> dict[str, Any]:
+        return {"var_upwind": self.var_upwind, "var_crosswind": self.var_crosswind, "cov": self.cov}
+
+    def __repr__(self) -> str:
+        def fmt(x: Any) -> str:
+            if isinstance(x, torch.Tensor):
+                return f"tensor{tuple(x.shape)}" if x.numel() > 1 else f"{x.item():.4g}"
+            return f"{float(x):.4g}"
+
+        return (
+            f"SlopeStatistics(var_upwind={fmt(self.var_upwind)}, "
+            f"var_crosswind={fmt(self.var_crosswind)}, cov={fmt(self.cov)})"
+        )
+
+
+def _values(x: Any) -> torch.Tensor:
+    return x.detach().double() if isinstance(x, torch.Tensor) else torch.as_tensor(x, dtype=torch.float64)
+
+
+def _square(x: Any) -> Any:
+    return x * x
+
+
+def _mul3(a: Any, b: Any, c: Any) -> Any:
+    return a * b * c
+
+
+def _sqrt(x: Any) -> Any:
+    return torch.sqrt(x) if isinstance(x, torch.Tensor) else math.sqrt(x)
+
+
+def slope_pdf(theta: Any, phi: Any, slopes: SlopeStatistics) -> torch.Tensor:
+    """Density p(θ, φ) of facet-normal directions, paper Eq. A7/A8 (Eq. 1 when r = 0) [rad⁻²].
+
+    Args:
+        theta: facet-normal zenith angle θ [rad], in [0, π/2).
+        phi: facet-normal azimuth φ from the upwind axis [rad].
+        slopes: the slope statistics.
+
+    Notes:
+        p(θ, φ) = sec²θ tanθ · N(s; 0, Σ) with s = tanθ (cos φ, sin φ): the bivariate normal of the
+        slopes times the Jacobian of (s_x, s_y) → (θ, φ). In this form the exponent is
+        −½ tan²θ (b² cos²φ + a² sin²φ − 2 r a b cos φ sin φ) / det Σ, which is A8 divided by
+        (1 − r²), i.e. the paper's Eq. A7.
+    """
+    dtype, device = resolve_dtype_device(theta=theta, phi=phi, **slopes.parameters_dict())
+    th = as_tensor(theta, dtype, device)
+    ph = as_tensor(phi, dtype, device)
+    vx, vy, cxy = slopes.tensors(dtype, device)
+    det = vx * vy - cxy * cxy
+    tan_t = torch.tan(th)
+    c, s = torch.cos(ph), torch.sin(ph)
+    quad = tan_t**2 * (vy * c * c + vx * s * s - 2.0 * cxy * c * s) / det
+    jac = tan_t / torch.cos(th) ** 2
+    return jac * torch.exp(-0.5 * quad) / (2.0 * math.pi * torch.sqrt(det))
