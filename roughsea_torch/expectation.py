@@ -404,7 +404,7 @@ def emissivity(
     Example:
         >>> s = SlopeStatistics.cox_munk(5.0)
         >>> round(float(emissivity(0.0, 0.0, s, 1.218 + 0.0508j)), 4)
-        0.9897
+        0.9898
     """
     dtype, device, vz, va, vx, vy, cxy = _prepare(view_zenith, view_azimuth, slopes, refractive_index)
     n, k = split_refractive_index(refractive_index, dtype, device)
