@@ -328,8 +328,12 @@ def _run_chunked(
     per_eval_points: int,
     q: Quadrature,
     fn: Callable[[slice], torch.Tensor],
+    dtype: torch.dtype,
+    device: torch.device,
 ) -> torch.Tensor:
     total = int(math.prod(batch_shape))
+    if total == 0:
+        return torch.zeros(batch_shape, dtype=dtype, device=device)
     step = max(1, q.chunk // max(per_eval_points, 1))
     if total <= step:
         return fn(slice(0, total)).reshape(batch_shape)
@@ -338,13 +342,13 @@ def _run_chunked(
 
 
 def _prepare(view_zenith, view_azimuth, slopes, refractive_index=None, **extra):
-    _check_angles(view_zenith, view_azimuth)
     _check_slopes(slopes)
     tensors = dict(view_zenith=view_zenith, view_azimuth=view_azimuth, **slopes.parameters_dict())
     if refractive_index is not None:
         tensors["refractive_index"] = refractive_index
     tensors.update({k: v for k, v in extra.items() if isinstance(v, torch.Tensor)})
-    dtype, device = resolve_dtype_device(**tensors)
+    dtype, device = resolve_dtype_device(**tensors)  # device mismatch is reported first
+    _check_angles(view_zenith, view_azimuth)
     vz = as_tensor(view_zenith, dtype, device)
     va = as_tensor(view_azimuth, dtype, device)
     vx, vy, cxy = slopes.tensors(dtype, device)
@@ -425,7 +429,7 @@ def emissivity(
     def one(sl: slice) -> torch.Tensor:
         return (_emissivity_numerator(gw.take(sl), nw[sl], kw[sl], shadowing, q) / Dw[sl]).to(dtype)
 
-    return _run_chunked(shape, points, q, one)
+    return _run_chunked(shape, points, q, one, dtype, device)
 
 
 def apparent_radiance(
@@ -485,4 +489,4 @@ def apparent_radiance(
         sky_c = _sky_chunk(sky_fn, shape, sl, device)
         return rbf[sl] + _sky_numerator(g.take(sl), nf[sl], kf[sl], rbf[sl], sky_c, q) / D[sl]
 
-    return _run_chunked(shape, q.outer * q.inner, q, one)
+    return _run_chunked(shape, 3 * q.outer * q.inner, q, one, dtype, device)
