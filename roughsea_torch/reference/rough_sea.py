@@ -1,0 +1,460 @@
+"""Rough-sea projected area, emissivity and apparent radiance by adaptive quadrature (reference).
+
+Everything is computed in the paper's facet-normal coordinates (theta, phi):
+
+  p(theta, phi)       Eq. 1 / A7-A8, density of facet normals (per rad^2)
+  cos(Omega)          Eq. 6: cos(theta) cos(th) + sin(theta) sin(th) cos(phi - ph)
+                      (th, ph = view zenith and azimuth of the line of sight sea -> sensor)
+  f_hat(theta, phi)   Eq. 5: p cos(Omega)/cos(theta) H(pi/2 - Omega) / D,
+                      D = int int p cos(Omega)/cos(theta) H(pi/2 - Omega) dtheta dphi
+                      (Eq. 4/7 without H, where D = cos(th) exactly)
+  cos(theta')         Eq. 9: 2 cos(Omega) cos(theta) - cos(th), zenith angle of the reflected ray
+  R_a                 Eq. 10: int int f_hat {[1 - rho(Omega)] R_B + rho(Omega) R_s(theta')}
+
+Integration: scipy.integrate.quad, nested. Default ("phi_outer"): outer integral over the facet
+azimuth phi in [0, 2 pi], inner over theta. For each phi the inner theta range is cut, in closed form,
+at the places where the integrand jumps or kinks:
+
+  * shadow edge cos(Omega) = 0. Writing cos(Omega) = A cos(theta - delta) with
+    A = sqrt(cos^2 th + sin^2 th cos^2(phi - ph)), delta = atan2(sin th cos(phi - ph), cos th),
+    the edge is theta_s = pi/2 + delta (inside [0, pi/2) only when cos(phi - ph) < 0).
+    With shadowing theta_s is the upper limit (H = 0 beyond); without it theta_s is a breakpoint
+    (rho(|cos Omega|) has a kink there and the weight changes sign).
+  * sky/sea edge cos(theta') = 0. Eq. 9 gives cos(theta') = A cos(2 theta - delta), so the edge is
+    theta_k = pi/4 + delta/2 = theta_s / 2. For theta > theta_k the reflected ray goes into the sea
+    (sees R_B).
+  * for a tabulated sky, the theta where theta' crosses a table node (PCHIP knots and the clamp).
+  * the density: tan(theta) is cut at N_RMS = 12 rms slopes of the slope component along phi,
+    1/sqrt(q(phi)), q = E(phi, r)/(1 - r^2) (Eq. A8); the neglected mass is exp(-72).
+
+The outer phi integral gets breakpoints at ph + k pi/2 (where the shadow/sky edges enter) and at
+the principal axes of the slope covariance, plus, when the law is strongly anisotropic, a geometric
+ladder alpha +- w 8^j around the major axis alpha (w = sqrt(l_min/l_max), the angular half-width of
+the phi-marginal of the density).
+A second, independent ordering ("theta_outer": theta outside, phi inside with the edges solved for
+phi) is provided for cross-checks.
+"""
+
+import math
+import warnings
+
+import numpy as np
+from scipy import integrate
+from scipy.interpolate import PchipInterpolator
+
+from .fresnel import _fresnel_scalar, as_complex_index
+from .slopes import _check_slope_arrays, _pdf_scalar
+
+__all__ = ["projected_area", "emissivity", "apparent_radiance"]
+
+HALF_PI = 0.5 * math.pi
+TWO_PI = 2.0 * math.pi
+N_RMS = 12.0  # density support: |slope along phi| < 12 rms slopes
+
+
+# ----------------------------------------------------------------------------- sky radiance
+
+class _Sky:
+    """Sky radiance R_s as a function of cos(zenith) of the reflected ray (W m^-2 sr^-1)."""
+
+    def __init__(self, sky):
+        self.nodes = None
+        self.constant = None
+        if callable(sky):
+            self.kind = "callable"
+            self.func = sky
+        elif isinstance(sky, (tuple, list)) and len(sky) == 2:
+            z = np.asarray(sky[0], dtype=np.float64)
+            rad = np.asarray(sky[1], dtype=np.float64)
+            if z.ndim != 1 or rad.shape != z.shape or z.size < 2:
+                raise ValueError("sky table must be two 1-d arrays of equal length >= 2")
+            if np.any(np.diff(z) <= 0) or z[0] < 0 or z[-1] > HALF_PI + 1e-12:
+                raise ValueError("sky table zenith must be strictly ascending within [0, pi/2]")
+            self.kind = "table"
+            self.nodes = z
+            self.values = rad
+            self.interp = PchipInterpolator(z, rad, extrapolate=False)
+        else:
+            v = np.asarray(sky, dtype=np.float64)
+            if v.ndim != 0:
+                raise ValueError("sky must be a callable, a constant or a (zenith, radiance) table")
+            self.kind = "constant"
+            self.constant = float(v)
+
+    def __call__(self, cos_zenith):
+        if self.kind == "constant":
+            return self.constant
+        if self.kind == "callable":
+            x = np.array([cos_zenith], dtype=np.float64)
+            y = np.broadcast_to(np.asarray(self.func(x), dtype=np.float64), x.shape)
+            return float(y[0])
+        zen = math.acos(min(max(cos_zenith, -1.0), 1.0))
+        if zen <= self.nodes[0]:
+            return float(self.values[0])
+        if zen >= self.nodes[-1]:
+            return float(self.values[-1])
+        return float(self.interp(zen))
+
+
+# ----------------------------------------------------------------------------- the integrand
+
+class _FacetIntegral:
+    """Scalar integrand of Eqs. 5/7 and 10 for one geometry and one slope law, and its quadrature.
+
+    kind: "area"  integrand p cos(Omega)/cos(theta) [H]                      (Eq. 5 denominator)
+          "emis"  integrand p cos(Omega)/cos(theta) [H] (1 - rho(|cos Omega|))
+          "rad"   integrand p cos(Omega)/cos(theta) [H] {(1 - rho) R_B + rho R_s(theta')} (Eq. 10)
+    The integrals returned are NOT normalized (divide by D, see the public functions).
+    """
+
+    def __init__(self, theta_hat, phi_hat, a, b, r, shadowing, kind,
+                 m=None, sea_radiance=None, sky=None):
+        self.th = float(theta_hat)
+        self.ph = float(phi_hat)
+        self.ct = math.cos(self.th)
+        self.st = math.sin(self.th)
+        self.a, self.b, self.r = float(a), float(b), float(r)
+        self.shadowing = bool(shadowing)
+        self.kind = kind
+        self.m = m
+        self.R_B = None if sea_radiance is None else float(sea_radiance)
+        self.sky = sky
+        # degenerate slope laws: slopes along one axis only (facet normals in one vertical plane)
+        if self.a > 0.0 and self.b > 0.0:
+            self.line = None
+        elif self.b == 0.0:
+            self.line = (self.a, (0.0, math.pi))           # s_y = 0: phi = 0 or pi
+        else:
+            self.line = (self.b, (HALF_PI, 1.5 * math.pi))  # s_x = 0: phi = pi/2 or 3pi/2
+
+    # --- model pieces --------------------------------------------------------------------------
+    def density(self, theta, phi):
+        """p(theta, phi), Eq. A7/A8; for a degenerate (line) law the density along the line."""
+        if self.line is None:
+            return _pdf_scalar(theta, phi, self.a, self.b, self.r)
+        sig = self.line[0]
+        t = math.tan(theta)
+        cos_t = math.cos(theta)
+        # s ~ N(0, sig^2) along the line; each sign of s gives one azimuth; ds = sec^2 dtheta
+        return math.exp(-0.5 * t * t / (sig * sig)) / (math.sqrt(TWO_PI) * sig * cos_t * cos_t)
+
+    def integrand(self, theta, phi):
+        cos_theta = math.cos(theta)
+        cos_omega = cos_theta * self.ct + math.sin(theta) * self.st * math.cos(phi - self.ph)  # Eq. 6
+        if self.shadowing and not cos_omega > 0.0:  # H(pi/2 - Omega), Eq. 5
+            return 0.0
+        w = self.density(theta, phi) * cos_omega / cos_theta  # Eq. 3 / 5 numerator
+        if self.kind == "area":
+            return w
+        rho = _fresnel_scalar(abs(cos_omega), self.m)
+        if self.kind == "emis":
+            return w * (1.0 - rho)
+        cos_tp = 2.0 * cos_omega * cos_theta - self.ct  # Eq. 9
+        if cos_tp < 0.0:
+            r_s = self.R_B  # reflected ray goes into the sea: it sees the sea (physics.md sec. 2)
+        else:
+            r_s = self.sky(min(cos_tp, 1.0))
+        return w * ((1.0 - rho) * self.R_B + rho * r_s)  # Eq. 10
+
+    def theta_max(self, phi):
+        """theta where tan(theta) = N_RMS rms slopes of the slope component along azimuth phi."""
+        if self.line is not None:
+            return math.atan(N_RMS * self.line[0])
+        a, b, r = self.a, self.b, self.r
+        c, s = math.cos(phi), math.sin(phi)
+        e = c * c / (a * a) + s * s / (b * b) - 2.0 * r * c * s / (a * b)  # Eq. A8
+        q = e / (1.0 - r * r)
+        return math.atan(N_RMS / math.sqrt(q))
+
+    def theta_max_global(self):
+        if self.line is not None:
+            return math.atan(N_RMS * self.line[0])
+        a, b, r = self.a, self.b, self.r
+        tr = a * a + b * b
+        det = a * a * b * b * (1.0 - r * r)
+        lam_max = 0.5 * tr + math.sqrt(max(0.25 * tr * tr - det, 0.0))
+        return math.atan(N_RMS * math.sqrt(lam_max))
+
+    def principal_azimuths(self):
+        """Azimuths of the principal axes of the slope covariance, plus, for a strongly anisotropic
+        law, a geometric ladder of breakpoints around the major axis.
+
+        The phi-marginal of the density is the angular central Gaussian
+        sqrt(l1 l2) / (2 pi (l2 cos^2(phi - alpha) + l1 sin^2(phi - alpha))), a Lorentzian-like peak of
+        half-width w = sqrt(l2 / l1) (l1 >= l2 the covariance eigenvalues) with 1/phi^2 tails. When w is
+        small, Gauss-Kronrod nodes on [alpha, alpha + pi/2] would step over the peak; breakpoints at
+        alpha +- w 8^j (j = 0, 1, ...) give quad panels matched to every scale of the peak.
+        """
+        if self.line is not None:
+            return list(self.line[1])
+        a, b, r = self.a, self.b, self.r
+        alpha = 0.5 * math.atan2(2.0 * r * a * b, a * a - b * b)
+        pts = [alpha + k * HALF_PI for k in range(4)]
+        tr = a * a + b * b
+        det = a * a * b * b * (1.0 - r * r)
+        disc = math.sqrt(max(0.25 * tr * tr - det, 0.0))
+        lam1 = 0.5 * tr + disc
+        lam2 = det / lam1
+        w = math.sqrt(lam2 / lam1)
+        while w < 0.25 * math.pi:
+            for axis in (alpha, alpha + math.pi):
+                pts.extend([axis - w, axis + w])
+            w *= 8.0
+        return pts
+
+    # --- phi outer, theta inner ----------------------------------------------------------------
+    def theta_edges(self, phi):
+        """Closed-form theta breakpoints (sorted, with 0 and the upper limit) for azimuth phi."""
+        c = math.cos(phi - self.ph)
+        delta = math.atan2(self.st * c, self.ct)
+        theta_shadow = HALF_PI + delta   # cos(Omega) = 0, Eq. 6
+        theta_sky = 0.5 * theta_shadow   # cos(theta') = 0, Eq. 9
+        upper = self.theta_max(phi)
+        if self.shadowing:
+            upper = min(upper, theta_shadow)
+        if upper <= 0.0:
+            return [0.0]
+        cuts = []
+        if not self.shadowing:
+            cuts.append(theta_shadow)
+        if self.kind == "rad":
+            cuts.append(theta_sky)
+            if self.sky.nodes is not None:
+                amp = math.hypot(self.ct, self.st * c)
+                for z in self.sky.nodes:
+                    x = math.cos(z) / amp
+                    if abs(x) <= 1.0:
+                        g = math.acos(x)
+                        cuts.extend([0.5 * (delta + g), 0.5 * (delta - g)])
+        inner = sorted(x for x in cuts if 0.0 < x < upper)
+        return [0.0] + inner + [upper]
+
+    def theta_integral(self, phi, epsrel):
+        edges = self.theta_edges(phi)
+        total = 0.0
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            if hi - lo < 1e-13:  # sliver (e.g. shadow edge at theta ~ 1e-16): midpoint rule is exact enough
+                total += (hi - lo) * self.integrand(0.5 * (lo + hi), phi)
+            else:
+                total += integrate.quad(self.integrand, lo, hi, args=(phi,),
+                                        epsabs=0.0, epsrel=epsrel, limit=200)[0]
+        return total
+
+    def phi_outer(self, epsrel):
+        inner_eps = max(1e-2 * epsrel, 1e-13)
+        if self.line is not None:
+            return sum(self.theta_integral(phi0, inner_eps) for phi0 in self.line[1])
+        pts = [self.ph + k * HALF_PI for k in range(4)] + self.principal_azimuths()
+        pts = _unique_mod_2pi(pts)
+        return integrate.quad(self.theta_integral, 0.0, TWO_PI, args=(inner_eps,),
+                              points=pts, epsabs=0.0, epsrel=epsrel, limit=1000)[0]
+
+    # --- theta outer, phi inner (independent ordering, for cross-checks) --------------------------
+    def phi_edges(self, theta):
+        cos2, sin2 = math.cos(2.0 * theta), math.sin(2.0 * theta)
+        cs = []  # values of cos(phi - ph) where something happens
+        if self.st > 0.0 and math.sin(theta) > 0.0:
+            cs.append(-math.cos(theta) * self.ct / (math.sin(theta) * self.st))   # cos(Omega) = 0
+            if self.kind == "rad":
+                cs.append(-cos2 * self.ct / (sin2 * self.st))                       # cos(theta') = 0
+                if self.sky.nodes is not None:
+                    for z in self.sky.nodes:
+                        cs.append((math.cos(z) - cos2 * self.ct) / (sin2 * self.st))
+        pts = [self.ph + k * HALF_PI for k in range(4)] + self.principal_azimuths()
+        for c in cs:
+            if -1.0 <= c <= 1.0:
+                g = math.acos(c)
+                pts.extend([self.ph + g, self.ph - g])
+        return _unique_mod_2pi(pts)
+
+    def phi_integral(self, theta, epsrel):
+        return integrate.quad(lambda phi: self.integrand(theta, phi), 0.0, TWO_PI,
+                              points=self.phi_edges(theta), epsabs=0.0, epsrel=epsrel,
+                              limit=1000)[0]
+
+    def theta_outer(self, epsrel):
+        inner_eps = max(1e-2 * epsrel, 1e-13)
+        if self.line is not None:
+            return self.phi_outer(epsrel)
+        upper = self.theta_max_global()
+        pts = [HALF_PI - self.th]
+        if self.kind == "rad":
+            pts += [0.5 * (HALF_PI - self.th), 0.5 * (HALF_PI + self.th)]
+            if self.sky.nodes is not None:
+                for z in self.sky.nodes:
+                    pts += [0.5 * (z + self.th), 0.5 * (z - self.th), 0.5 * (self.th - z)]
+        # theta where the shadow / sky edges cross the principal axes (where the mass is when a/b >> 1)
+        for beta in self.principal_azimuths()[:4]:
+            c = math.cos(beta - self.ph)
+            theta_shadow = HALF_PI + math.atan2(self.st * c, self.ct)
+            pts.append(theta_shadow)
+            if self.kind == "rad":
+                pts.append(0.5 * theta_shadow)
+        pts = sorted(x for x in pts if 0.0 < x < upper)
+        return integrate.quad(self.phi_integral, 0.0, upper, args=(inner_eps,),
+                              points=pts or None, epsabs=0.0, epsrel=epsrel, limit=1000)[0]
+
+    def integral(self, epsrel, method):
+        if method == "phi_outer":
+            return self.phi_outer(epsrel)
+        if method == "theta_outer":
+            return self.theta_outer(epsrel)
+        raise ValueError("method must be 'phi_outer' or 'theta_outer'")
+
+
+def _unique_mod_2pi(values):
+    """Reduce azimuths to (0, 2 pi), sort, drop near-duplicates and the end points."""
+    out = []
+    for v in sorted(x % TWO_PI for x in values):
+        if 1e-13 < v < TWO_PI - 1e-13 and (not out or v - out[-1] > 1e-13):
+            out.append(v)
+    return out
+
+
+# ----------------------------------------------------------------------------- input handling
+
+def _check_view(view_zenith, view_azimuth):
+    th = np.asarray(view_zenith, dtype=np.float64)
+    ph = np.asarray(view_azimuth, dtype=np.float64)
+    if np.any(np.isnan(th)) or np.any(th < 0.0) or np.any(th > HALF_PI):
+        raise ValueError("view_zenith must lie in [0, pi/2]")
+    if np.any(~np.isfinite(ph)):
+        raise ValueError("view_azimuth must be finite")
+    return th, ph
+
+
+def _slope_arrays(slopes):
+    return _check_slope_arrays(slopes.std_upwind, slopes.std_crosswind, slopes.corr)
+
+
+def _numerator(kind, th, ph, a, b, r, shadowing, m=None, sea_radiance=None, sky=None,
+               epsrel=1e-10, method="phi_outer"):
+    """Unnormalized integral of p cos(Omega)/cos(theta) [H] g over theta, phi (one scalar case)."""
+    fi = _FacetIntegral(th, ph, a, b, r, shadowing, kind, m, sea_radiance, sky)
+    return fi.integral(epsrel, method)
+
+
+def _projected_area_scalar(th, ph, a, b, r, shadowing, epsrel, method):
+    if a == 0.0 and b == 0.0:
+        return math.cos(th)  # flat sea: every facet horizontal, cos(Omega) = cos(th) >= 0
+    return _numerator("area", th, ph, a, b, r, shadowing, epsrel=epsrel, method=method)
+
+
+def _denominator(th, ph, a, b, r, shadowing, epsrel, method):
+    """D of Eq. 5 by quadrature (shadowing) or cos(th) of Eq. 7 (no shadowing)."""
+    if shadowing:
+        return _projected_area_scalar(th, ph, a, b, r, True, epsrel, method)
+    return math.cos(th)
+
+
+# ----------------------------------------------------------------------------- public API
+
+def projected_area(view_zenith, view_azimuth, slopes, shadowing=True, *, epsrel=1e-10,
+                   method="phi_outer"):
+    """Line-of-sight projected area per unit horizontal area: the denominator of Eq. 5 / Eq. 4.
+
+    D(th, ph) = int_0^{2pi} dphi int_0^{pi/2} dtheta p(theta, phi) cos(Omega)/cos(theta) [H(pi/2 - Omega)]
+    with cos(Omega) from Eq. 6 and p from Eq. A7/A8; H only when shadowing=True.
+    Without shadowing the exact value is cos(th) (paper, text before Eq. 7); here it is computed by
+    quadrature too, which is a check of the quadrature.
+
+    view_zenith th [rad] in [0, pi/2], view_azimuth ph [rad] from the upwind axis, slopes:
+    SlopeStatistics. Dimensionless. Broadcasts; returns a float64 array.
+    epsrel: relative tolerance of the outer quadrature (inner uses epsrel/100).
+    method: "phi_outer" (default) or "theta_outer" (independent ordering, for checks).
+    Flat sea (a = b = 0): cos(th) without quadrature. With shadowing=False and th = pi/2 exactly the
+    integral is 0 (cos(pi/2)); it is computed with an absolute tolerance of 1e-15 there.
+    """
+    th, ph = _check_view(view_zenith, view_azimuth)
+    a, b, r = _slope_arrays(slopes)
+    th, ph, a, b, r = np.broadcast_arrays(th, ph, a, b, r)
+    out = np.empty(th.shape, dtype=np.float64)
+    for idx in np.ndindex(th.shape):
+        t_, p_, a_, b_, r_ = (float(x[idx]) for x in (th, ph, a, b, r))
+        if not shadowing and t_ == HALF_PI and not (a_ == 0.0 and b_ == 0.0):
+            fi = _FacetIntegral(t_, p_, a_, b_, r_, False, "area")
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", integrate.IntegrationWarning)
+                out[idx] = _outer_abs(fi, 1e-15)
+            continue
+        out[idx] = _projected_area_scalar(t_, p_, a_, b_, r_, shadowing, epsrel, method)
+    return out
+
+
+def _outer_abs(fi, epsabs):
+    """phi-outer integral with an absolute tolerance (used only where the exact value is 0)."""
+    if fi.line is not None:
+        return sum(fi.theta_integral(phi0, 1e-12) for phi0 in fi.line[1])
+    pts = _unique_mod_2pi([fi.ph + k * HALF_PI for k in range(4)] + fi.principal_azimuths())
+    return integrate.quad(fi.theta_integral, 0.0, TWO_PI, args=(1e-12,), points=pts,
+                          epsabs=epsabs, epsrel=1e-10, limit=1000)[0]
+
+
+def emissivity(view_zenith, view_azimuth, slopes, refractive_index, shadowing=True, *,
+               epsrel=1e-10, method="phi_outer"):
+    """Rough-sea emissivity (dimensionless): int int f_hat(theta, phi) [1 - rho(Omega)] dtheta dphi.
+
+    f_hat from Eq. 5 (shadowing=True: H(pi/2 - Omega) in numerator and denominator, the denominator
+    D by quadrature) or Eq. 7 (shadowing=False: denominator cos(th); facets turned away,
+    cos(Omega) < 0, keep their negative weight and rho is evaluated at |cos(Omega)|).
+    rho: unpolarized Fresnel reflectance for m = n + ik (k >= 0): complex, complex array or (n, k).
+    Flat sea (a = b = 0): 1 - rho(cos th) without quadrature.
+    shadowing=False at th = pi/2 exactly (non-flat): Eq. 7 divides by cos(pi/2) = 0 and its numerator
+    integral is also 0 (odd in cos(phi - ph)); the result is NaN (0/0).
+    Note: without shadowing, near grazing the numerator is a difference of terms ~rms slope that
+    nearly cancel to ~cos(th); the relative accuracy is then ~1e-16 * slope / cos(th) at best.
+    """
+    th, ph = _check_view(view_zenith, view_azimuth)
+    a, b, r = _slope_arrays(slopes)
+    m = as_complex_index(refractive_index)
+    th, ph, a, b, r, m = np.broadcast_arrays(th, ph, a, b, r, m)
+    out = np.empty(th.shape, dtype=np.float64)
+    for idx in np.ndindex(th.shape):
+        t_, p_, a_, b_, r_ = (float(x[idx]) for x in (th, ph, a, b, r))
+        m_ = complex(m[idx])
+        if a_ == 0.0 and b_ == 0.0:
+            out[idx] = 1.0 - _fresnel_scalar(math.cos(t_), m_)
+            continue
+        if not shadowing and t_ == HALF_PI:
+            out[idx] = math.nan
+            continue
+        num = _numerator("emis", t_, p_, a_, b_, r_, shadowing, m=m_, epsrel=epsrel, method=method)
+        out[idx] = num / _denominator(t_, p_, a_, b_, r_, shadowing, epsrel, method)
+    return out
+
+
+def apparent_radiance(view_zenith, view_azimuth, slopes, refractive_index, sea_radiance, sky,
+                      shadowing=True, *, epsrel=1e-10, method="phi_outer"):
+    """Apparent radiance of the rough sea R_a, Eq. 10 (units of sea_radiance, W m^-2 sr^-1).
+
+    R_a = int int f_hat(theta, phi) {[1 - rho(Omega)] R_B + rho(Omega) R_s(theta')} dtheta dphi,
+    f_hat from Eq. 5 (or Eq. 7 when shadowing=False), cos(theta') = 2 cos(Omega) cos(theta) - cos(th)
+    (Eq. 9). R_B = sea_radiance. Where cos(theta') < 0 the reflected ray goes into the sea and
+    R_s is replaced by R_B (single bounce; keeps R_a = R_B when the sky equals R_B).
+    sky: callable f(cos_zenith ndarray) -> radiance ndarray; or a constant; or a table
+    (zenith_rad, radiance) of 1-d arrays, zenith ascending in [0, pi/2], interpolated in zenith
+    angle with PchipInterpolator(extrapolate=False) and held at the end values outside the table.
+    Flat sea (a = b = 0): (1 - rho(cos th)) R_B + rho(cos th) R_s(th) without quadrature.
+    shadowing=False at th = pi/2 exactly (non-flat): NaN (0/0 in Eq. 7), as for emissivity().
+    """
+    th, ph = _check_view(view_zenith, view_azimuth)
+    a, b, r = _slope_arrays(slopes)
+    m = as_complex_index(refractive_index)
+    rb = np.asarray(sea_radiance, dtype=np.float64)
+    sky_f = _Sky(sky)
+    th, ph, a, b, r, m, rb = np.broadcast_arrays(th, ph, a, b, r, m, rb)
+    out = np.empty(th.shape, dtype=np.float64)
+    for idx in np.ndindex(th.shape):
+        t_, p_, a_, b_, r_, rb_ = (float(x[idx]) for x in (th, ph, a, b, r, rb))
+        m_ = complex(m[idx])
+        if a_ == 0.0 and b_ == 0.0:
+            rho = _fresnel_scalar(math.cos(t_), m_)
+            out[idx] = (1.0 - rho) * rb_ + rho * sky_f(math.cos(t_))
+            continue
+        if not shadowing and t_ == HALF_PI:
+            out[idx] = math.nan
+            continue
+        num = _numerator("rad", t_, p_, a_, b_, r_, shadowing, m=m_, sea_radiance=rb_, sky=sky_f,
+                         epsrel=epsrel, method=method)
+        out[idx] = num / _denominator(t_, p_, a_, b_, r_, shadowing, epsrel, method)
+    return out
