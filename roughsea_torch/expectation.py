@@ -224,12 +224,11 @@ def _sky_numerator(
     g: _Geom,
     n: torch.Tensor,
     k: torch.Tensor,
-    rb: torch.Tensor,
     sky: Callable[[torch.Tensor], torch.Tensor],
     q: Quadrature,
     split: bool,
-) -> torch.Tensor:
-    """∫_C N t ρ(Ω) [R_s(θ') − R_B] ds over the disc C of sky-reflecting facets."""
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """(∫_C N t ρ(Ω) R_s(θ') ds, ∫_C N t ρ(Ω) ds) over the disc C of sky-reflecting facets."""
     dtype, device = g.ct.dtype, g.ct.device
     tiny = torch.finfo(dtype).tiny
     xo, wo = _nodes("gl", q.outer, dtype, device)
@@ -298,8 +297,48 @@ def _sky_numerator(
     rs, rp, _, _ = _fresnel_terms(cos_o, n[:, None, None], k[:, None, None])
     m = cos_r.shape[0]
     radiance = sky(cos_r.reshape(m, -1)).reshape(cos_r.shape)
-    inner = (Wz * 0.5 * (rs + rp) * (radiance - rb[:, None, None])).sum(-1)
-    return (W * t * inner).sum(-1)
+    w_rho = Wz * 0.5 * (rs + rp)
+    wt = W * t
+    return (wt * (w_rho * radiance).sum(-1)).sum(-1), (wt * w_rho.sum(-1)).sum(-1)
+
+
+def _sky_terms(
+    g: _Geom,
+    n: torch.Tensor,
+    k: torch.Tensor,
+    sky_fn: Callable,
+    shape: torch.Size,
+    D: torch.Tensor,
+    q: Quadrature,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Flat (T_s, T_ρ) = (1/D)(∫_C N t ρ R_s, ∫_C N t ρ), so that R_a = R_B (1 − T_ρ) + T_s (Eq. 10).
+
+    The sky disc's outer panel is split per sea state where the Gaussian ridge is thin; the
+    grouping makes results independent of batching and chunking.
+    """
+    device = g.ct.device
+    need_split = (g.tau < q.split * g.kappa.abs() * g.su).detach()
+    total = need_split.numel()
+    out_s = out_r = None
+    for split in (False, True):
+        idx = torch.nonzero(need_split == split).flatten()
+        if idx.numel() == 0:
+            continue
+        step = max(1, q.chunk // ((3 if split else 1) * q.outer * q.inner))
+        parts_s, parts_r = [], []
+        for i in range(0, idx.numel(), step):
+            sel = idx[i : i + step]
+            i_s, i_r = _sky_numerator(g.take(sel), n[sel], k[sel], _sky_chunk(sky_fn, shape, sel, device), q, split)
+            parts_s.append(i_s / D[sel])
+            parts_r.append(i_r / D[sel])
+        vs, vr = torch.cat(parts_s), torch.cat(parts_r)
+        if idx.numel() == total:
+            out_s, out_r = vs, vr
+        else:
+            zeros = torch.zeros(total, dtype=vs.dtype, device=device)
+            out_s = (zeros if out_s is None else out_s).index_put((idx,), vs)
+            out_r = (zeros if out_r is None else out_r).index_put((idx,), vr)
+    return out_s, out_r
 
 
 # -- argument handling -----------------------------------------------------------------------
@@ -474,7 +513,9 @@ def apparent_radiance(
 
     Notes:
         The emission term is not integrated separately: with ∫ f̂ = 1, Eq. 10 equals
-        R_B + ∫ f̂ ρ (R_s − R_B), whose integrand is non-zero only on facets that reflect sky.
+        R_B + ∫ f̂ ρ (R_s − R_B), whose integrand is non-zero only on facets that reflect sky;
+        it is evaluated as R_B (1 − T_ρ) + T_s with T_ρ = ∫_C f̂ ρ and T_s = ∫_C f̂ ρ R_s over
+        those facets, so R_s ≡ R_B gives R_a = R_B to rounding.
         A user callable ``sky`` receives a tensor of shape (M, N) (M sea states of a chunk, N
         directions each) and must act elementwise.
     """
@@ -496,26 +537,7 @@ def apparent_radiance(
     nf, kf = n.expand(shape).reshape(-1), k.expand(shape).reshape(-1)
     rbf = rb.expand(shape).reshape(-1)
 
-    need_split = (g.tau < q.split * g.kappa.abs() * g.su).detach()
-    total = need_split.numel()
-    if total == 0:
+    if rbf.numel() == 0:
         return torch.zeros(shape, dtype=dtype, device=device)
-    out = None
-    for split in (False, True):
-        idx = torch.nonzero(need_split == split).flatten()
-        if idx.numel() == 0:
-            continue
-        per_eval = (3 if split else 1) * q.outer * q.inner
-        step = max(1, q.chunk // per_eval)
-        parts = []
-        for i in range(0, idx.numel(), step):
-            sel = idx[i : i + step]
-            sky_c = _sky_chunk(sky_fn, shape, sel, device)
-            parts.append(rbf[sel] + _sky_numerator(g.take(sel), nf[sel], kf[sel], rbf[sel], sky_c, q, split) / D[sel])
-        vals = torch.cat(parts)
-        if idx.numel() == total:
-            out = vals
-        else:
-            base = out if out is not None else torch.zeros(total, dtype=vals.dtype, device=device)
-            out = base.index_put((idx,), vals)
-    return out.reshape(shape)
+    t_s, t_rho = _sky_terms(g, nf, kf, sky_fn, shape, D, q)
+    return (rbf - rbf * t_rho + t_s).reshape(shape)
