@@ -16,7 +16,7 @@ Public core::
 ``rs.reference`` holds an independent numpy implementation with the same signatures.
 """
 
-from .expectation import Quadrature, apparent_radiance, emissivity, projected_area, smith_lambda
+from .expectation import Quadrature, apparent_radiance, emissivity, projected_area, reflection_terms, smith_lambda
 from .optics import (
     band_reflectance,
     band_refractive_index,

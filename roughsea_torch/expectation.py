@@ -56,6 +56,7 @@ __all__ = [
     "smith_lambda",
     "emissivity",
     "apparent_radiance",
+    "reflection_terms",
 ]
 
 _INV_SQRT_2PI = 1.0 / math.sqrt(2.0 * math.pi)
@@ -520,24 +521,47 @@ def apparent_radiance(
         directions each) and must act elementwise.
     """
     check_finite_range("sea_radiance", sea_radiance, 0.0, unit="W m-2 sr-1")
+    t_s, t_rho = reflection_terms(
+        view_zenith, view_azimuth, slopes, refractive_index, sky, shadowing, quadrature, _extra=dict(sea_radiance=sea_radiance)
+    )
+    rb = as_tensor(sea_radiance, t_s.dtype, t_s.device)
+    return rb - rb * t_rho + t_s
+
+
+def reflection_terms(
+    view_zenith: Any,
+    view_azimuth: Any,
+    slopes: SlopeStatistics,
+    refractive_index: Any = 1.218 + 0.0508j,
+    sky: Any = None,
+    shadowing: bool = True,
+    quadrature: Quadrature | None = None,
+    _extra: dict | None = None,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """The two sky-reflection integrals of Eq. 10: R_a = R_B (1 − T_ρ) + T_s.
+
+    T_ρ = ∫∫ f̂ ρ(Ω) H(cos θ') and T_s = ∫∫ f̂ ρ(Ω) R_s(θ') H(cos θ') over the facets whose reflected
+    ray reaches the sky (the others see the sea, R_B). T_ρ is dimensionless; T_s has the units of
+    the sky radiance. Both are independent of the sea temperature, so a renderer can tabulate them
+    once per sea state and apply R_B per pixel. Arguments as :func:`apparent_radiance`.
+    """
     sky_fn = as_sky(sky)
     sky_tensor = sky_fn.radiance if isinstance(sky_fn, (TabulatedSky, ConstantSky)) else None
+    extra = {k: v for k, v in (_extra or {}).items() if isinstance(v, torch.Tensor)}
     dtype, device, vz, va, vx, vy, cxy = _prepare(
-        view_zenith, view_azimuth, slopes, refractive_index, sea_radiance=sea_radiance,
-        sky=sky_tensor if isinstance(sky_tensor, torch.Tensor) else None,
+        view_zenith, view_azimuth, slopes, refractive_index,
+        sky=sky_tensor if isinstance(sky_tensor, torch.Tensor) else None, **extra,
     )
     n, k = split_refractive_index(refractive_index, dtype, device)
-    rb = as_tensor(sea_radiance, dtype, device)
     q = quadrature or Quadrature.default(dtype)
     shape = torch.broadcast_shapes(
-        vz.shape, va.shape, vx.shape, vy.shape, cxy.shape, n.shape, k.shape, rb.shape, _sky_batch_shape(sky_fn)
+        vz.shape, va.shape, vx.shape, vy.shape, cxy.shape, n.shape, k.shape, _sky_batch_shape(sky_fn)
     )
     g = _geometry(vz, va, vx, vy, cxy).flat(shape)
+    if g.ct.numel() == 0:
+        z = torch.zeros(shape, dtype=dtype, device=device)
+        return z, z
     D = _denominator(g, shadowing)
     nf, kf = n.expand(shape).reshape(-1), k.expand(shape).reshape(-1)
-    rbf = rb.expand(shape).reshape(-1)
-
-    if rbf.numel() == 0:
-        return torch.zeros(shape, dtype=dtype, device=device)
     t_s, t_rho = _sky_terms(g, nf, kf, sky_fn, shape, D, q)
-    return (rbf - rbf * t_rho + t_s).reshape(shape)
+    return t_s.reshape(shape), t_rho.reshape(shape)
