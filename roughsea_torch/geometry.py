@@ -67,7 +67,7 @@ def make_camera(
     Example:
         >>> cams = make_camera(48, 64, hfov_deg=30.0, altitude_m=20.0, pitch_deg=-3.0, batch_size=2)
         >>> centre = -(cams.rotation_matrix.transpose(-1, -2) @ cams.translation_vector)[..., 0]
-        >>> tuple(cams.extrinsics.shape), [round(float(v), 6) for v in centre[0]]
+        >>> tuple(cams.extrinsics.shape), [round(float(v), 3) + 0.0 for v in centre[0]]
         ((2, 4, 4), [0.0, 0.0, 20.0])
     """
     if not (isinstance(height, int) and isinstance(width, int) and height > 0 and width > 0):
