@@ -33,14 +33,21 @@ from .radiometry import (
     planck_radiance,
 )
 from .sky import ConstantSky, TabulatedSky
+from .geometry import EARTH_RADIUS_M, ViewGeometry, make_camera, view_geometry
+from .render import SeaRenderer, SeaScene, TableSize, render
 from .slopes import SlopeStatistics, slope_pdf
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "EARTH_RADIUS_M",
     "LWIR",
     "MWIR",
     "ConstantSky",
+    "SeaRenderer",
+    "SeaScene",
+    "TableSize",
+    "ViewGeometry",
     "Quadrature",
     "SlopeStatistics",
     "SpectralBand",
@@ -53,9 +60,13 @@ __all__ = [
     "emissivity",
     "fresnel_emissivity",
     "fresnel_reflectance",
+    "make_camera",
     "planck_radiance",
     "projected_area",
+    "reflection_terms",
+    "render",
     "slope_pdf",
     "smith_lambda",
+    "view_geometry",
     "water_refractive_index",
 ]

