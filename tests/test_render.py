@@ -1,0 +1,183 @@
+"""Cameras, per-pixel geometry and the renderer."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import torch
+
+import roughsea_torch as rs
+
+DEG = math.pi / 180
+
+
+def sky(c):
+    return 11.0 + 19.0 * (1.0 - c) ** 8
+
+
+def varied_cameras(dtype, H=64, W=80):
+    """Five cameras: low near-horizontal, 200 m, 2 km oblique wide, 5 m grazing narrow, nadir."""
+    return rs.make_camera(
+        H, W,
+        hfov_deg=torch.tensor([30.0, 30.0, 60.0, 10.0, 40.0]),
+        altitude_m=torch.tensor([20.0, 200.0, 2000.0, 5.0, 20.0]),
+        pitch_deg=torch.tensor([-3.0, -10.0, -45.0, -0.5, -89.0]),
+        yaw_deg=torch.tensor([0.0, 40.0, 100.0, -30.0, 0.0]),
+        roll_deg=torch.tensor([0.0, 5.0, -10.0, 2.0, 0.0]),
+        dtype=dtype,
+    )
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+@pytest.mark.parametrize("anisotropic", [False, True])
+def test_table_render_matches_direct_per_pixel_evaluation(dtype, anisotropic):
+    """Every sea pixel within 2e-5 relative of apparent_radiance at its own (θ̂, φ̂), including the
+    rows next to the horizon (θ̂ up to 89.99° here); sky pixels identical."""
+    cams = varied_cameras(dtype)
+    scene = rs.SeaScene(
+        wind_speed=torch.tensor([2.0, 10.0, 25.0, 0.0, 40.0]), anisotropic=anisotropic,
+        wind_direction=torch.tensor([0.3, 1.0, 2.5, -1.0, 0.0]),
+        sea_temperature=torch.tensor([285.0, 295.0, 300.0, 275.0, 290.0]), sky=sky,
+    )
+    geom = rs.view_geometry(cams)
+    table = rs.render(cams, scene, geometry=geom)
+    direct = rs.render(cams, scene, geometry=geom, method="direct")
+    assert table.shape == (5, 1, 64, 80) and table.dtype == dtype
+    sea = geom.is_sea[:, None]
+    rel = ((table - direct).abs() / direct.abs())[sea]
+    assert rel.max() <= 2e-5
+    near_horizon = (geom.view_zenith > 89.9 * DEG)[:, None] & sea
+    assert near_horizon.sum() > 0  # the check above covered rows within 0.1° of the horizon
+    assert torch.equal(table[~sea], direct[~sea])
+
+
+def test_horizon_depression_and_distance_on_a_sphere():
+    """physics.md §8: at h = 20 m the horizon is depressed by √(2h/R) = 0.1436° and lies √(2hR) ≈ 16 km
+    away. A camera pitched to the horizon: the first sea row is the one just below it, and the
+    sea pixel farthest away is at ≈ the horizon distance."""
+    h, R = 20.0, 6_371_000.0
+    dip = math.degrees(math.sqrt(2 * h / R))
+    H = 2001
+    cams = rs.make_camera(H, 3, hfov_deg=0.6, altitude_m=h, pitch_deg=-dip, dtype=torch.float64)
+    geom = rs.view_geometry(cams, earth_radius_m=R)
+    col = geom.is_sea[0, :, 1]
+    first = int(torch.nonzero(col)[0])
+    f = float(cams.fx[0])
+    elev = lambda row: -dip + math.degrees(math.atan(((H - 1) / 2 - row) / f))  # noqa: E731
+    assert elev(first) <= -dip < elev(first - 1)  # the sea starts at the depressed horizon
+    assert abs(dip - 0.1436) < 5e-4
+    far = float(geom.range_m[0, first, 1])
+    assert abs(far - math.sqrt(2 * h * R)) / math.sqrt(2 * h * R) < 0.02
+    assert float(geom.view_zenith[0, first, 1]) > 89.9 * DEG  # LOS tangent at the horizon
+
+
+def test_flat_sea_geometry_is_the_plane():
+    cams = rs.make_camera(33, 5, hfov_deg=20.0, altitude_m=50.0, pitch_deg=-30.0, dtype=torch.float64)
+    geom = rs.view_geometry(cams, earth_radius_m=float("inf"))
+    centre = geom.view_zenith[0, 16, 2]
+    assert abs(float(centre) - 60 * DEG) < 1e-12  # optical axis 30° below horizontal → θ̂ = 60°
+    assert abs(float(geom.range_m[0, 16, 2]) - 50.0 / math.sin(30 * DEG)) < 1e-9
+    sphere = rs.view_geometry(cams)
+    # on a sphere the local vertical at the hit tilts away from the camera: θ̂ grows, slightly
+    assert float(sphere.view_zenith[0, 16, 2]) > float(centre)
+    assert float(sphere.view_zenith[0, 16, 2]) - float(centre) < 1e-4
+
+
+def test_los_azimuth_points_back_to_the_camera():
+    """A camera with yaw 0 looks along +x: the LOS sea → sensor of its central pixel points to −x."""
+    cams = rs.make_camera(11, 11, hfov_deg=20.0, altitude_m=10.0, pitch_deg=-20.0, yaw_deg=0.0, dtype=torch.float64)
+    az = float(rs.view_geometry(cams).view_azimuth[0, 5, 5])
+    assert abs(abs(az) - math.pi) < 1e-9
+    cams = rs.make_camera(11, 11, hfov_deg=20.0, altitude_m=10.0, pitch_deg=-20.0, yaw_deg=90.0, dtype=torch.float64)
+    az = float(rs.view_geometry(cams).view_azimuth[0, 5, 5])
+    assert abs(az + math.pi / 2) < 1e-9
+
+
+def test_sky_pixels_see_the_sky_along_their_ray():
+    cams = rs.make_camera(40, 40, hfov_deg=40.0, altitude_m=20.0, pitch_deg=15.0, dtype=torch.float64)
+    scene = rs.SeaScene(wind_speed=5.0, sea_temperature=290.0, sky=sky)
+    geom = rs.view_geometry(cams)
+    img = rs.render(cams, scene, geometry=geom)
+    s = ~geom.is_sea[0]
+    torch.testing.assert_close(img[0, 0][s], sky(geom.cos_view_zenith[0][s].clamp(0, 1)), rtol=1e-12, atol=0)
+
+
+def test_second_law_whole_image_is_uniform_brightness_temperature():
+    """Sky radiance equal to the sea's blackbody radiance everywhere ⇒ every pixel, sea or sky, is
+    at the sea temperature (Eq. 10 with R_s ≡ R_B, through geometry, tables and grid_sample)."""
+    t_sea = 291.5
+    rb = float(rs.band_radiance(torch.tensor(t_sea, dtype=torch.float64)))
+    cams = varied_cameras(torch.float64, 32, 40)
+    scene = rs.SeaScene(wind_speed=torch.tensor([1.0, 5.0, 10.0, 20.0, 30.0]), sea_temperature=t_sea, sky=rb)
+    bt = rs.render(cams, scene, output="brightness_temperature")
+    torch.testing.assert_close(bt, torch.full_like(bt, t_sea), rtol=0, atol=1e-9)
+
+
+def test_gradients_match_finite_differences():
+    """d image / d (wind speed, sea temperature, pitch, altitude), float64, table method."""
+    def image(w, t, pitch, alt):
+        cams = rs.make_camera(12, 16, hfov_deg=20.0, altitude_m=alt, pitch_deg=pitch, yaw_deg=10.0, dtype=torch.float64)
+        scene = rs.SeaScene(wind_speed=w, wind_direction=0.4, sea_temperature=t, sky=sky)
+        return rs.render(cams, scene, output="brightness_temperature")
+
+    x0 = [torch.tensor(v, dtype=torch.float64) for v in (7.0, 290.0, -6.0, 30.0)]
+    xs = [v.clone().requires_grad_(True) for v in x0]
+    img = image(*xs)
+    weights = torch.linspace(0.5, 1.5, img.numel(), dtype=torch.float64).reshape(img.shape)
+    grads = torch.autograd.grad((img * weights).sum(), xs)
+    steps = (1e-3, 1e-3, 1e-4, 1e-3)
+    for i, (g, h) in enumerate(zip(grads, steps)):
+        up = [v.clone() for v in x0]
+        dn = [v.clone() for v in x0]
+        up[i] += h
+        dn[i] -= h
+        fd = ((image(*up) - image(*dn)) * weights).sum() / (2 * h)
+        assert torch.isfinite(g)
+        assert abs(float(g) - float(fd)) <= 2e-3 * abs(float(fd)) + 1e-8, (i, float(g), float(fd))
+
+
+def test_nothing_requires_grad_means_no_graph():
+    cams = rs.make_camera(8, 8, altitude_m=20.0, pitch_deg=-5.0)
+    img = rs.render(cams, rs.SeaScene(wind_speed=5.0, sea_temperature=290.0, sky=sky))
+    assert img.grad_fn is None and not img.requires_grad
+
+
+def test_module_equals_function_and_no_sky_work_when_no_sky():
+    """An all-sea view makes no per-pixel sky call (shape (B, H·W)); a view with sky does."""
+    shapes = []
+
+    def counting_sky(c):
+        shapes.append(tuple(c.shape))
+        return sky(c)
+
+    scene = rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, sky=counting_sky)
+    all_sea = rs.make_camera(16, 16, altitude_m=100.0, pitch_deg=-60.0)
+    assert rs.view_geometry(all_sea).is_sea.all()
+    a = rs.SeaRenderer()(all_sea, scene)
+    assert (1, 256) not in shapes
+    b = rs.render(all_sea, scene)
+    assert torch.equal(a, b)
+    shapes.clear()
+    rs.render(rs.make_camera(16, 16, altitude_m=100.0, pitch_deg=0.0), scene)
+    assert (1, 256) in shapes
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda: rs.make_camera(8, 8, altitude_m=0.0), "altitude_m"),
+        (lambda: rs.make_camera(8, 8, pitch_deg=95.0), "pitch_deg"),
+        (lambda: rs.make_camera(8, 8, hfov_deg=0.0), "hfov_deg"),
+        (lambda: rs.SeaScene(sea_temperature=290.0, sky=1.0), "wind_speed"),
+        (lambda: rs.SeaScene(wind_speed=3.0, sky=1.0), "sea_temperature"),
+        (lambda: rs.SeaScene(wind_speed=-3.0, sea_temperature=290.0, sky=1.0), "wind_speed"),
+        (lambda: rs.SeaScene(wind_speed=3.0, sea_temperature=500.0, sky=1.0), "sea_temperature"),
+        (lambda: rs.render(rs.make_camera(8, 8, batch_size=2), rs.SeaScene(wind_speed=torch.ones(3), sea_temperature=290.0, sky=1.0)), "batch size"),
+        (lambda: rs.render(rs.make_camera(8, 8), rs.SeaScene(wind_speed=3.0, sea_temperature=290.0, sky=1.0), method="fast"), "method"),
+        (lambda: rs.view_geometry(rs.make_camera(8, 8), earth_radius_m=-1.0), "earth_radius_m"),
+    ],
+)
+def test_render_errors(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
