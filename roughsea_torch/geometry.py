@@ -9,7 +9,6 @@ a sphere of radius ``earth_radius_m`` centred at (0, 0, −R) (``float('inf')``:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import torch
@@ -119,26 +118,47 @@ def make_camera(
     return PinholeCamera(intrinsics, extrinsics, h, w)
 
 
-@dataclass
 class ViewGeometry:
     """Per-pixel view geometry, every field (B, H, W).
 
     Attributes:
-        view_zenith: sea pixels: θ̂, zenith angle of the line of sight sea → sensor at the hit
-            point, against the local vertical (which tilts with range on a sphere) [rad];
-            sky pixels: zenith angle of the ray itself, the direction whose sky radiance they see
-            (> π/2 for rays between the horizontal and the depressed horizon).
+        cos_view_zenith: sea pixels: cos θ̂, θ̂ the zenith angle of the line of sight sea → sensor
+            at the hit point, against the local vertical (which tilts with range on a sphere);
+            sky pixels: cos of the zenith angle of the ray itself, the direction whose sky radiance
+            they see (< 0 for rays between the horizontal and the depressed horizon).
+        view_zenith: arccos of the above [rad].
         view_azimuth: world azimuth of the LOS sea → sensor (sea pixels) or of the reversed ray
             (sky pixels) [rad], from +x towards +y, in (−π, π].
         is_sea: the ray meets the sea.
         range_m: slant range to the sea [m] (inf for sky pixels).
+
+    ``view_zenith``, ``view_azimuth`` and ``range_m`` are computed on first access (a renderer of
+    isotropic seas never needs the azimuth, nor one without a path model the range).
     """
 
-    view_zenith: torch.Tensor
-    view_azimuth: torch.Tensor
-    is_sea: torch.Tensor
-    range_m: torch.Tensor
-    cos_view_zenith: torch.Tensor  # float64: cos θ̂ (sea) or cos of the ray's zenith (sky), exact near 90°
+    def __init__(self, cos_view_zenith, is_sea, dx, dy, rng_fn):
+        self.cos_view_zenith = cos_view_zenith
+        self.is_sea = is_sea
+        self._dx, self._dy, self._rng_fn = dx, dy, rng_fn
+        self._cache: dict[str, torch.Tensor] = {}
+
+    @property
+    def view_zenith(self) -> torch.Tensor:
+        if "vz" not in self._cache:
+            self._cache["vz"] = torch.acos(self.cos_view_zenith.clamp(-1.0, 1.0))
+        return self._cache["vz"]
+
+    @property
+    def view_azimuth(self) -> torch.Tensor:
+        if "va" not in self._cache:
+            self._cache["va"] = torch.atan2(-self._dy, -self._dx)
+        return self._cache["va"]
+
+    @property
+    def range_m(self) -> torch.Tensor:
+        if "rng" not in self._cache:
+            self._cache["rng"] = self._rng_fn()
+        return self._cache["rng"]
 
 
 def view_geometry(
@@ -147,18 +167,21 @@ def view_geometry(
     """Per-pixel view geometry of a batch of kornia cameras over the sea.
 
     Rays come from ``kornia.geometry.depth.unproject_meshgrid`` (pixel centres at integers) and
-    are rotated to world axes. The sphere intersection is computed in float64 in a
-    cancellation-free form: with P the camera relative to the Earth's centre and d the unit ray,
-    b = P·d, c = |P|² − R² (written as |C|² + 2 C_z R), the near root is s = c / (−b + √(b² − c))
-    and cos θ̂ = √(b² − c) / R, exact up to the horizon where it tends to 0.
+    are rotated to world axes. By spherical symmetry a camera at P (relative to the Earth's centre)
+    is at altitude h = |P| − R above the sea point under it, with local vertical n̂ = P/|P|. With
+    d the unit ray and dz = d·n̂, b = |P| dz and c = h (2R + h), the near root of the intersection
+    is s = c / (−b + √(b² − c)) and cos θ̂ = √(b² − c) / R; written as
+    b² − c = (R + h)² (dz − s_h)(dz + s_h), s_h = √(h(2R + h))/(R + h) the sine of the horizon dip,
+    both are free of cancellation up to the horizon, in float32 too (per-camera constants in
+    float64). World azimuths use the world x, y axes (the scene is small against R).
 
     Args:
         cameras: kornia ``PinholeCamera`` with B cameras of one image size.
         earth_radius_m: R [m]; ``float('inf')`` for a flat sea.
-        chunk: images processed at once (bounds the float64 temporaries).
+        chunk: images processed at once (bounds the temporaries).
 
     Returns:
-        :class:`ViewGeometry` in the cameras' dtype (``cos_view_zenith`` in float64).
+        :class:`ViewGeometry` in the cameras' dtype.
     """
     check_finite_range("earth_radius_m", earth_radius_m, 0.0, math.inf, lo_open=True, unit="m")
     H, W = int(cameras.height[0].item()), int(cameras.width[0].item())
@@ -167,44 +190,53 @@ def view_geometry(
     dtype = cameras.intrinsics.dtype
     dev = cameras.device()
     flat = math.isinf(earth_radius_m)
-    out: dict[str, list[torch.Tensor]] = {k: [] for k in ("vz", "va", "sea", "rng", "cz")}
+    centres = -(cameras.rotation_matrix.transpose(-1, -2) @ cameras.translation_vector)[..., 0]
+    P = centres.to(torch.float64)
+    if not flat:
+        P = P + torch.tensor([0.0, 0.0, earth_radius_m], dtype=torch.float64, device=dev)
+    # Spherical symmetry: a camera anywhere is a camera at altitude h = |P| − R above the point of
+    # the sea under it, whose local vertical n̂ = P/|P| (flat sea: n̂ = z, h = C_z).
+    alt = (P[:, 2] if flat else P.norm(dim=-1) - earth_radius_m)
+    if bool((~(alt > 0)).any()):
+        raise ValueError("cameras: every camera centre must be above the sea (altitude > 0)")
+    up = torch.nn.functional.normalize(P, dim=-1) if not flat else P.new_tensor([0.0, 0.0, 1.0]).expand_as(P)
+    # world axes x, y and the local vertical, as rows, in each camera's frame (float64 → dtype)
+    axes = torch.stack([P.new_tensor([1.0, 0.0, 0.0]).expand_as(P), P.new_tensor([0.0, 1.0, 0.0]).expand_as(P), up], 1)
+    axes_cam = (axes.to(cameras.rotation_matrix.dtype) @ cameras.rotation_matrix.transpose(-1, -2)).to(dtype)
+    if not flat:
+        Re = earth_radius_m
+        k_r = ((Re + alt) / Re).to(dtype)  # (R + h)/R
+        s_h = (torch.sqrt(alt * (2 * Re + alt)) / (Re + alt)).to(dtype)  # sine of the horizon dip
+        num = (alt * (2 * Re + alt) / (Re + alt)).to(dtype)  # h (2R + h)/(R + h) [m]
+    dxs, dys, dzs, cos_all, seas = [], [], [], [], []
     for i in range(0, cameras.batch_size, chunk):
         sl = slice(i, i + chunk)
-        K = cameras.camera_matrix[sl].to(torch.float64)
-        Rm = cameras.rotation_matrix[sl].to(torch.float64)
-        t = cameras.translation_vector[sl].to(torch.float64)  # (b, 3, 1)
-        C = -(Rm.transpose(-1, -2) @ t)[..., 0]  # camera centre in world (b, 3)
-        rays = unproject_meshgrid(H, W, K, normalize_points=True, device=dev, dtype=torch.float64)
-        d = torch.einsum("bhwi,bij->bhwj", rays, Rm)  # world ray = Rᵀ d_cam
-        dx, dy, dz = d.unbind(-1)
-        cz = C[:, 2, None, None]
-        if (C[:, 2] <= 0).any():
-            raise ValueError("cameras: every camera centre must be above the sea (z > 0)")
+        rays = unproject_meshgrid(H, W, cameras.camera_matrix[sl], normalize_points=True, device=dev, dtype=dtype)
+        b_ = rays.shape[0]
+        d = (rays.reshape(b_, H * W, 3) @ axes_cam[sl].transpose(-1, -2)).reshape(b_, H, W, 3)
+        dx, dy, dz = d.unbind(-1)  # world x, y and local-vertical components of the unit ray
         if flat:
             sea = dz < 0
-            cos_t = (-dz).clamp_min(0.0)
-            s = torch.where(sea, cz / torch.where(sea, -dz, torch.ones_like(dz)), torch.full_like(dz, math.inf))
+            cos_t = -dz
         else:
-            Re = earth_radius_m
-            b = C[:, 0, None, None] * dx + C[:, 1, None, None] * dy + (cz + Re) * dz
-            c = (C[:, 0] ** 2 + C[:, 1] ** 2 + C[:, 2] ** 2 + 2.0 * C[:, 2] * Re)[:, None, None]
-            disc = b * b - c
-            sea = (b < 0) & (disc >= 0)
-            root = torch.sqrt(disc.clamp_min(0.0))
-            s = torch.where(sea, c / torch.where(sea, root - b, torch.ones_like(b)), torch.full_like(b, math.inf))
-            cos_t = root / Re
-        cz_sky = dz  # cos of the ray's own zenith angle
-        cos_all = torch.where(sea, cos_t, cz_sky)
-        out["cz"].append(cos_all)
-        out["vz"].append(torch.acos(cos_all.clamp(-1.0, 1.0)))
-        out["va"].append(torch.atan2(-dy, -dx))
-        out["sea"].append(sea)
-        out["rng"].append(s)
-    cat = {k: torch.cat(v) for k, v in out.items()}
-    return ViewGeometry(
-        view_zenith=cat["vz"].to(dtype),
-        view_azimuth=cat["va"].to(dtype),
-        is_sea=cat["sea"],
-        range_m=cat["rng"].to(dtype),
-        cos_view_zenith=cat["cz"],
-    )
+            # b² − c = (R + h)² (dz² − s_h²): the sea is met iff −dz > s_h; cancellation-free.
+            sh = s_h[sl, None, None]
+            sea = -dz > sh
+            cos_t = k_r[sl, None, None] * torch.sqrt(((-dz - sh) * (-dz + sh)).clamp_min(0.0))  # √(b² − c)/R
+        cos_all.append(torch.where(sea, cos_t, dz))  # sea: cos θ̂ at the hit; sky: the ray's own cos(zenith)
+        seas.append(sea)
+        dxs.append(dx)
+        dys.append(dy)
+        dzs.append(dz)
+    cat = lambda v: torch.cat(v) if len(v) > 1 else v[0]  # noqa: E731
+    cz, sea, dz = cat(cos_all), cat(seas), cat(dzs)
+
+    def slant_range() -> torch.Tensor:
+        if flat:
+            rng = alt.to(dtype)[:, None, None] / torch.where(sea, -dz, torch.ones_like(dz))
+        else:  # c / (√(b² − c) − b) = h(2R + h)/(R + h) / (√(dz² − s_h²) − dz)
+            root = cz / k_r[:, None, None]
+            rng = num[:, None, None] / torch.where(sea, root - dz, torch.ones_like(dz))
+        return torch.where(sea, rng, torch.full_like(rng, math.inf))
+
+    return ViewGeometry(cz, sea, cat(dxs), cat(dys), slant_range)

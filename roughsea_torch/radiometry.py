@@ -191,7 +191,8 @@ def band_radiance(temperature: Any, band: Any = LWIR, response: Any = None) -> t
 
 
 class _BrightnessTemperature(torch.autograd.Function):
-    """Inverse of the band radiance; backward by the implicit-function theorem dT/dL = 1/(dL/dT)."""
+    """Inverse of the band radiance by Newton iterations (float64); backward by the implicit-function
+    theorem dT/dL = 1/(dL/dT). Used outside the tabulated 100–500 K range."""
 
     @staticmethod
     def forward(ctx, radiance, lam, w):  # type: ignore[override]
@@ -221,18 +222,53 @@ class _BrightnessTemperature(torch.autograd.Function):
         return grad / dLdT, None, None
 
 
+_T_LO, _T_HI, _T_STEP = 100.0, 500.0, 0.25
+_bt_cache: dict[tuple, tuple[torch.Tensor, ...]] = {}
+
+
+def _bt_table(band: SpectralBand, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, ...]:
+    """Band radiance L(T) and dL/dT on a 0.25 K grid over 100–500 K (float64 nodes, cached)."""
+    key = (hash(band), dtype, device)
+    hit = _bt_cache.get(key)
+    if hit is None:
+        lam, w = (torch.as_tensor(a, dtype=torch.float64) for a in band.quadrature)
+        T = torch.arange(_T_LO, _T_HI + _T_STEP / 2, _T_STEP, dtype=torch.float64)
+        L = (_planck(lam, T[:, None]) * w).sum(-1)
+        dL = (_planck_dT(lam, T[:, None]) * w).sum(-1)
+        hit = tuple(t.to(device=device, dtype=dtype) for t in (T, L, dL))
+        _bt_cache[key] = hit
+    return hit
+
+
 def brightness_temperature(radiance: Any, band: Any = LWIR, response: Any = None) -> torch.Tensor:
     """Temperature [K] of the blackbody whose band radiance equals ``radiance`` [W m⁻² sr⁻¹].
 
-    Inverse of :func:`band_radiance` (Newton iterations in float64, returned in the input's
-    dtype); differentiable, with dT/dL = 1 / (dL/dT).
+    Inverse of :func:`band_radiance`: cubic Hermite interpolation of T(L) between band radiances
+    tabulated every 0.25 K over 100–500 K with their exact slopes dT/dL = 1/(dL/dT) (error
+    ~1e-9 K, O(h⁴)); Newton iterations in float64 outside that range. Differentiable.
     """
     check_finite_range("radiance", radiance, 0.0, lo_open=True, unit="W m-2 sr-1")
     b = as_band(band, response)
     dtype, device = resolve_dtype_device(radiance=radiance)
     L = as_tensor(radiance, dtype, device)
-    lam, w = b.nodes(dtype, device)
-    return _BrightnessTemperature.apply(L, lam, w)
+    T, Ln, dL = _bt_table(b, dtype, device)
+    inside = (L >= Ln[0]) & (L <= Ln[-1])
+    i = torch.searchsorted(Ln, L.detach().contiguous()).clamp(1, Ln.numel() - 1) - 1
+    x0, x1 = Ln[i], Ln[i + 1]
+    h = x1 - x0
+    t = (L - x0) / h
+    t2, t3 = t * t, t * t * t
+    out = (
+        (2 * t3 - 3 * t2 + 1) * T[i]
+        + (t3 - 2 * t2 + t) * h / dL[i]
+        + (-2 * t3 + 3 * t2) * T[i + 1]
+        + (t3 - t2) * h / dL[i + 1]
+    )
+    if not bool(inside.all()):
+        lam, w = b.nodes(dtype, device)
+        far = _BrightnessTemperature.apply(L, lam, w)
+        out = torch.where(inside, out, far)
+    return out
 
 
 def band_weights(

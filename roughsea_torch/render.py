@@ -218,13 +218,27 @@ def _sky_radiance_pixels(sky: Any, cos_z: torch.Tensor) -> torch.Tensor:
     return sky(c)
 
 
-def _azimuth_window(phi: torch.Tensor, mask: torch.Tensor) -> tuple[float, float, float]:
-    """Centre and offset range of relative azimuths (period π: the slope density is symmetric
-    under s → −s, so R_a(φ̂ + π) = R_a(φ̂))."""
-    p = phi[mask]
-    c = 0.5 * math.atan2(float(torch.sin(2 * p).mean()), float(torch.cos(2 * p).mean()))
-    o = torch.remainder(p - c + math.pi / 2, math.pi) - math.pi / 2
-    return c, float(o.min()), float(o.max())
+def _masked_range(x: torch.Tensor, mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """Per-image (min, max) of x over mask, (B, H, W) → (B,), detached."""
+    inf = torch.tensor(math.inf, dtype=x.dtype, device=x.device)
+    x = x.detach()
+    return torch.where(mask, x, inf).amin((1, 2)), torch.where(mask, x, -inf).amax((1, 2))
+
+
+def _azimuth_offsets(phi: torch.Tensor, mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """Per-image centre c (B,) and per-pixel offsets wrap_π(φ̂ − c) ∈ [−π/2, π/2) (B, H, W).
+
+    Period π: the slope density is symmetric under s → −s, so R_a(φ̂ + π) = R_a(φ̂). The centre is
+    the circular mean of 2φ̂ over the sea pixels, halved.
+    """
+    step = max(1, int(math.sqrt(phi[0].numel() / 4096)))  # ~4096 pixels suffice for a centre
+    p2 = 2.0 * phi.detach()[:, ::step, ::step]
+    m = mask[:, ::step, ::step]
+    m = torch.where(m.flatten(1).any(1)[:, None, None], m, mask[:, ::step, ::step] | True)
+    zero = torch.zeros((), dtype=phi.dtype, device=phi.device)
+    c = 0.5 * torch.atan2(torch.where(m, torch.sin(p2), zero).sum((1, 2)), torch.where(m, torch.cos(p2), zero).sum((1, 2)))
+    o = torch.remainder(phi - c[:, None, None] + math.pi / 2, math.pi) - math.pi / 2
+    return c, o
 
 
 def render(
@@ -265,17 +279,14 @@ def render(
     p = scene.resolved(B, dtype, device)
     q = quadrature or Quadrature.default(dtype)
     sea = geom.is_sea
-    flat_sea = sea.reshape(B, -1)
-    img = torch.zeros(B, H * W, dtype=dtype, device=device)
-    if bool((~flat_sea).any()):  # sky pixels: the sky along their own ray
-        sky_pix = _sky_radiance_pixels(_sky_per_image(p["sky"], B, dtype, device, 0), geom.cos_view_zenith.reshape(B, -1).to(dtype))
-        img = torch.where(flat_sea, img, sky_pix)
-    if bool(flat_sea.any()):
-        if method == "direct":
-            sea_vals = _sea_direct(geom, p, scene, q)
-        else:
-            sea_vals = _sea_table(geom, p, scene, q, table)
-        img = torch.where(flat_sea, sea_vals.reshape(B, -1), img)
+    any_sky, any_sea = bool((~sea).any()), bool(sea.any())
+    img = None
+    if any_sea:
+        img = _sea_direct(geom, p, scene, q) if method == "direct" else _sea_table(geom, p, scene, q, table)
+    if any_sky:  # sky pixels: the sky along their own ray; no sky work when no pixel sees sky
+        sky_pix = _sky_radiance_pixels(_sky_per_image(p["sky"], B, dtype, device, 0), geom.cos_view_zenith.reshape(B, -1))
+        sky_pix = sky_pix.reshape(B, H, W)
+        img = sky_pix if img is None else torch.where(sea, img, sky_pix)
     img = img.reshape(B, 1, H, W)
     if output == "brightness_temperature":
         return brightness_temperature(img.clamp_min(torch.finfo(dtype).tiny), scene.band)
@@ -316,42 +327,35 @@ def _sea_table(
     # ε: a quarter of the smallest rms slope of each image, so ζ resolves the grazing layer.
     lam_min = 0.5 * (p["vx"] + p["vy"] - torch.sqrt((p["vx"] - p["vy"]) ** 2 + 4 * p["cxy"] ** 2))
     eps = (0.25 * torch.sqrt(lam_min.detach().clamp_min(0.0))).clamp(1e-4, 0.05).double()
-    cz = geom.cos_view_zenith.detach()
-    # the pixel coordinate in ζ follows the pixel's own θ̂ (the value the direct method uses too)
-    ct_pix = torch.cos(geom.view_zenith.double()).clamp_min(0.0)
-    zeta_pix = torch.asinh(ct_pix / eps[:, None, None])
+    # the pixel coordinate in ζ, from the pixel's own cos θ̂ in the render dtype
+    eps_t = eps.to(dtype)[:, None, None]
+    zeta_pix = torch.asinh(geom.cos_view_zenith.clamp_min(0.0) / eps_t)
     nz, nphi = table.zenith, (1 if iso else table.azimuth)
     xz, Lz, ez = _lobatto_interp(nz, table.fine_zenith)
     xp, Lp, ep = _lobatto_interp(nphi, 1 if iso else table.fine_azimuth)
-    zeta_nodes, phi_nodes, gy, gx = [], [], [], []
-    phi_rel = _relative_azimuth(geom, p)
-    for b in range(B):
-        m = sea[b]
-        if not bool(m.any()):
-            zeta_nodes.append(torch.zeros(nz, dtype=torch.float64, device=device))
-            phi_nodes.append(torch.zeros(nphi, dtype=torch.float64, device=device))
-            gy.append(torch.zeros(H, W, dtype=dtype, device=device))
-            gx.append(torch.zeros(H, W, dtype=dtype, device=device))
-            continue
-        zs = zeta_pix[b][m].detach()
-        lo, hi = float(zs.min()), float(zs.max())
-        pad = max(1e-9, 1e-6 * (hi - lo))
-        lo, hi = lo - pad, hi + pad
-        zeta_nodes.append(torch.as_tensor(lo + (hi - lo) * (xz + 1) / 2, dtype=torch.float64, device=device))
-        gy.append(((2.0 * (zeta_pix[b] - lo) / (hi - lo) - 1.0) / (1.0 + ez)).to(dtype))
-        if iso:
-            phi_nodes.append(torch.zeros(1, dtype=torch.float64, device=device))
-            gx.append(torch.zeros(H, W, dtype=dtype, device=device))
-        else:
-            c, olo, ohi = _azimuth_window(phi_rel[b].detach().double(), m)
-            pad = max(1e-6, 1e-6 * (ohi - olo))
-            olo, ohi = olo - pad, ohi + pad
-            phi_nodes.append(torch.as_tensor(c + olo + (ohi - olo) * (xp + 1) / 2, dtype=torch.float64, device=device))
-            o = torch.remainder(phi_rel[b].double() - c + math.pi / 2, math.pi) - math.pi / 2
-            gx.append(((2.0 * (o - olo) / (ohi - olo) - 1.0) / (1.0 + ep)).to(dtype))
-    zeta_n = torch.stack(zeta_nodes)  # (B, nz)
+    any_sea = sea.flatten(1).any(1)
+    lo, hi = _masked_range(zeta_pix, sea)
+    lo = torch.where(any_sea, lo, torch.zeros_like(lo)).double()
+    hi = torch.where(any_sea, hi, torch.ones_like(hi)).double()
+    pad = torch.clamp(1e-6 * (hi - lo), min=1e-9)
+    lo, hi = lo - pad, hi + pad
+    xz_t = torch.as_tensor(xz, dtype=torch.float64, device=device)
+    zeta_n = lo[:, None] + (hi - lo)[:, None] * (xz_t + 1) / 2  # (B, nz)
+    gy = (2.0 * (zeta_pix - lo.to(dtype)[:, None, None]) / (hi - lo).to(dtype)[:, None, None] - 1.0) / (1.0 + ez)
+    if iso:
+        ph_nodes = torch.zeros(B, 1, dtype=dtype, device=device)
+        gx = torch.zeros_like(gy)
+    else:
+        c, o = _azimuth_offsets(_relative_azimuth(geom, p), sea)
+        olo, ohi = _masked_range(o, sea)
+        olo = torch.where(any_sea, olo, torch.zeros_like(olo)).double()
+        ohi = torch.where(any_sea, ohi, torch.ones_like(ohi)).double()
+        pad = torch.clamp(1e-6 * (ohi - olo), min=1e-6)
+        olo, ohi = olo - pad, ohi + pad
+        xp_t = torch.as_tensor(xp, dtype=torch.float64, device=device)
+        ph_nodes = (c.double()[:, None] + olo[:, None] + (ohi - olo)[:, None] * (xp_t + 1) / 2).to(dtype)
+        gx = (2.0 * (o - olo.to(dtype)[:, None, None]) / (ohi - olo).to(dtype)[:, None, None] - 1.0) / (1.0 + ep)
     th_nodes = torch.acos((eps[:, None] * torch.sinh(zeta_n)).clamp(0.0, 1.0)).to(dtype)
-    ph_nodes = torch.stack(phi_nodes).to(dtype)
     vz = th_nodes[:, :, None].expand(B, nz, nphi)
     va = ph_nodes[:, None, :].expand(B, nz, nphi)
     slopes = SlopeStatistics.from_variances(p["vx"][:, None, None], p["vy"][:, None, None], p["cxy"][:, None, None])
@@ -363,16 +367,15 @@ def _sea_table(
         t_s, t_rho = reflection_terms(
             vz, va, slopes, (p["n"][:, None, None], p["k"][:, None, None]), sky, scene.shadowing, q
         )
-    coarse = torch.stack([t_s, t_rho], 1)  # (B, 2, nz, nphi)
+    rb = p["rb"][:, None, None]
+    coarse = rb - rb * t_rho + t_s  # R_a at the nodes (B, nz, nphi); linear in the node values
     Lz_t = torch.as_tensor(Lz, dtype=dtype, device=device)
     Lp_t = torch.as_tensor(Lp, dtype=dtype, device=device)
-    fine = torch.einsum("iz,bczp,jp->bcij", Lz_t, coarse, Lp_t)  # (B, 2, Mz, Mp)
-    grid = torch.stack([torch.stack(gx), torch.stack(gy)], -1)  # (B, H, W, 2): x = azimuth, y = ζ
+    fine = torch.einsum("iz,bzp,jp->bij", Lz_t, coarse, Lp_t)[:, None]  # (B, 1, Mz, Mp)
+    grid = torch.stack([gx, gy], -1)  # (B, H, W, 2): x = azimuth, y = ζ
     # bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges only
     # to first order; bilinear on the fine table is second order (~1e-7 at 4096 rows).
-    vals = F.grid_sample(fine, grid, mode="bilinear", padding_mode="border", align_corners=True)  # (B, 2, H, W)
-    rb = p["rb"][:, None, None]
-    return rb - rb * vals[:, 1] + vals[:, 0]
+    return F.grid_sample(fine, grid, mode="bilinear", padding_mode="border", align_corners=True)[:, 0]
 
 
 class SeaRenderer(torch.nn.Module):
