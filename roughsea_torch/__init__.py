@@ -35,6 +35,7 @@ from .radiometry import (
 from .sky import ConstantSky, TabulatedSky
 from .geometry import EARTH_RADIUS_M, ViewGeometry, make_camera, view_geometry
 from .render import SeaRenderer, SeaScene, TableSize, render
+from .sensitivity import pixel_derivative
 from .slopes import SlopeStatistics, slope_pdf
 
 __version__ = "0.1.0"
@@ -61,6 +62,7 @@ __all__ = [
     "fresnel_emissivity",
     "fresnel_reflectance",
     "make_camera",
+    "pixel_derivative",
     "planck_radiance",
     "projected_area",
     "reflection_terms",
