@@ -17,7 +17,7 @@ from kornia.geometry.depth import unproject_meshgrid
 
 from ._validation import check_finite_range
 
-__all__ = ["EARTH_RADIUS_M", "make_camera", "ViewGeometry", "view_geometry"]
+__all__ = ["EARTH_RADIUS_M", "make_camera", "ViewGeometry", "view_geometry", "CameraGeometry"]
 
 EARTH_RADIUS_M = 6_371_000.0
 
@@ -183,60 +183,73 @@ def view_geometry(
     Returns:
         :class:`ViewGeometry` in the cameras' dtype.
     """
-    check_finite_range("earth_radius_m", earth_radius_m, 0.0, math.inf, lo_open=True, unit="m")
-    H, W = int(cameras.height[0].item()), int(cameras.width[0].item())
-    if not (torch.all(cameras.height == H) and torch.all(cameras.width == W)):
-        raise ValueError("cameras: every camera of a batch must have the same image size")
-    dtype = cameras.intrinsics.dtype
-    dev = cameras.device()
-    flat = math.isinf(earth_radius_m)
-    centres = -(cameras.rotation_matrix.transpose(-1, -2) @ cameras.translation_vector)[..., 0]
-    P = centres.to(torch.float64)
-    if not flat:
-        P = P + torch.tensor([0.0, 0.0, earth_radius_m], dtype=torch.float64, device=dev)
-    # Spherical symmetry: a camera anywhere is a camera at altitude h = |P| − R above the point of
-    # the sea under it, whose local vertical n̂ = P/|P| (flat sea: n̂ = z, h = C_z).
-    alt = (P[:, 2] if flat else P.norm(dim=-1) - earth_radius_m)
-    if bool((~(alt > 0)).any()):
-        raise ValueError("cameras: every camera centre must be above the sea (altitude > 0)")
-    up = torch.nn.functional.normalize(P, dim=-1) if not flat else P.new_tensor([0.0, 0.0, 1.0]).expand_as(P)
-    # world axes x, y and the local vertical, as rows, in each camera's frame (float64 → dtype)
-    axes = torch.stack([P.new_tensor([1.0, 0.0, 0.0]).expand_as(P), P.new_tensor([0.0, 1.0, 0.0]).expand_as(P), up], 1)
-    axes_cam = (axes.to(cameras.rotation_matrix.dtype) @ cameras.rotation_matrix.transpose(-1, -2)).to(dtype)
-    if not flat:
-        Re = earth_radius_m
-        k_r = ((Re + alt) / Re).to(dtype)  # (R + h)/R
-        s_h = (torch.sqrt(alt * (2 * Re + alt)) / (Re + alt)).to(dtype)  # sine of the horizon dip
-        num = (alt * (2 * Re + alt) / (Re + alt)).to(dtype)  # h (2R + h)/(R + h) [m]
-    dxs, dys, dzs, cos_all, seas = [], [], [], [], []
-    for i in range(0, cameras.batch_size, chunk):
-        sl = slice(i, i + chunk)
-        rays = unproject_meshgrid(H, W, cameras.camera_matrix[sl], normalize_points=True, device=dev, dtype=dtype)
+    geo = CameraGeometry(cameras, earth_radius_m)
+    parts = [geo.pixels(slice(i, i + chunk)) for i in range(0, geo.batch_size, chunk)]
+    cat = lambda k: torch.cat([p[k] for p in parts]) if len(parts) > 1 else parts[0][k]  # noqa: E731
+    cz, sea, dz = cat("cos"), cat("sea"), cat("dz")
+    return ViewGeometry(cz, sea, cat("dx"), cat("dy"), lambda: geo.slant_range(cz, sea, dz))
+
+
+class CameraGeometry:
+    """Per-camera constants of the sea intersection, and the per-pixel geometry of any chunk of
+    cameras (``pixels(slice)``), so that a renderer can stream images without holding the batch.
+
+    See :func:`view_geometry` for the formulas.
+    """
+
+    def __init__(self, cameras: PinholeCamera, earth_radius_m: float = EARTH_RADIUS_M):
+        check_finite_range("earth_radius_m", earth_radius_m, 0.0, math.inf, lo_open=True, unit="m")
+        H, W = int(cameras.height[0].item()), int(cameras.width[0].item())
+        if not (torch.all(cameras.height == H) and torch.all(cameras.width == W)):
+            raise ValueError("cameras: every camera of a batch must have the same image size")
+        self.cameras, self.H, self.W = cameras, H, W
+        self.batch_size = cameras.batch_size
+        self.dtype = dtype = cameras.intrinsics.dtype
+        self.device = dev = cameras.device()
+        self.flat = flat = math.isinf(earth_radius_m)
+        centres = -(cameras.rotation_matrix.transpose(-1, -2) @ cameras.translation_vector)[..., 0]
+        P = centres.to(torch.float64)
+        if not flat:
+            P = P + torch.tensor([0.0, 0.0, earth_radius_m], dtype=torch.float64, device=dev)
+        # Spherical symmetry: a camera anywhere is a camera at altitude h = |P| − R above the point
+        # of the sea under it, whose local vertical is n̂ = P/|P| (flat sea: n̂ = z, h = C_z).
+        alt = P[:, 2] if flat else P.norm(dim=-1) - earth_radius_m
+        if bool((~(alt > 0)).any()):
+            raise ValueError("cameras: every camera centre must be above the sea (altitude > 0)")
+        self.alt = alt
+        up = torch.nn.functional.normalize(P, dim=-1) if not flat else P.new_tensor([0.0, 0.0, 1.0]).expand_as(P)
+        # world axes x, y and the local vertical, as rows, in each camera's frame
+        axes = torch.stack([P.new_tensor([1.0, 0.0, 0.0]).expand_as(P), P.new_tensor([0.0, 1.0, 0.0]).expand_as(P), up], 1)
+        self.axes_cam = (axes.to(cameras.rotation_matrix.dtype) @ cameras.rotation_matrix.transpose(-1, -2)).to(dtype)
+        if not flat:
+            Re = earth_radius_m
+            self.k_r = ((Re + alt) / Re).to(dtype)  # (R + h)/R
+            self.s_h = (torch.sqrt(alt * (2 * Re + alt)) / (Re + alt)).to(dtype)  # sine of the horizon dip
+            self.num = (alt * (2 * Re + alt) / (Re + alt)).to(dtype)  # h (2R + h)/(R + h) [m]
+
+    def pixels(self, sl: slice) -> dict[str, torch.Tensor]:
+        """cos θ̂ (sea) / cos of the ray's zenith (sky), the sea mask, and the unit ray's world x, y
+        and local-vertical components, for the cameras ``sl``: each (b, H, W)."""
+        H, W = self.H, self.W
+        rays = unproject_meshgrid(H, W, self.cameras.camera_matrix[sl], normalize_points=True, device=self.device, dtype=self.dtype)
         b_ = rays.shape[0]
-        d = (rays.reshape(b_, H * W, 3) @ axes_cam[sl].transpose(-1, -2)).reshape(b_, H, W, 3)
-        dx, dy, dz = d.unbind(-1)  # world x, y and local-vertical components of the unit ray
-        if flat:
+        d = (rays.reshape(b_, H * W, 3) @ self.axes_cam[sl].transpose(-1, -2)).reshape(b_, H, W, 3)
+        dx, dy, dz = d.unbind(-1)
+        if self.flat:
             sea = dz < 0
             cos_t = -dz
         else:
             # b² − c = (R + h)² (dz² − s_h²): the sea is met iff −dz > s_h; cancellation-free.
-            sh = s_h[sl, None, None]
+            sh = self.s_h[sl, None, None]
             sea = -dz > sh
-            cos_t = k_r[sl, None, None] * torch.sqrt(((-dz - sh) * (-dz + sh)).clamp_min(0.0))  # √(b² − c)/R
-        cos_all.append(torch.where(sea, cos_t, dz))  # sea: cos θ̂ at the hit; sky: the ray's own cos(zenith)
-        seas.append(sea)
-        dxs.append(dx)
-        dys.append(dy)
-        dzs.append(dz)
-    cat = lambda v: torch.cat(v) if len(v) > 1 else v[0]  # noqa: E731
-    cz, sea, dz = cat(cos_all), cat(seas), cat(dzs)
+            cos_t = self.k_r[sl, None, None] * torch.sqrt(((-dz - sh) * (-dz + sh)).clamp_min(0.0))  # √(b² − c)/R
+        return {"cos": torch.where(sea, cos_t, dz), "sea": sea, "dx": dx, "dy": dy, "dz": dz}
 
-    def slant_range() -> torch.Tensor:
-        if flat:
-            rng = alt.to(dtype)[:, None, None] / torch.where(sea, -dz, torch.ones_like(dz))
+    def slant_range(self, cz: torch.Tensor, sea: torch.Tensor, dz: torch.Tensor) -> torch.Tensor:
+        """Slant range [m] to the sea (inf for sky pixels) from a full batch's ``pixels`` output."""
+        if self.flat:
+            rng = self.alt.to(self.dtype)[:, None, None] / torch.where(sea, -dz, torch.ones_like(dz))
         else:  # c / (√(b² − c) − b) = h(2R + h)/(R + h) / (√(dz² − s_h²) − dz)
-            root = cz / k_r[:, None, None]
-            rng = num[:, None, None] / torch.where(sea, root - dz, torch.ones_like(dz))
+            root = cz / self.k_r[:, None, None]
+            rng = self.num[:, None, None] / torch.where(sea, root - dz, torch.ones_like(dz))
         return torch.where(sea, rng, torch.full_like(rng, math.inf))
-
-    return ViewGeometry(cz, sea, cat(dxs), cat(dys), slant_range)

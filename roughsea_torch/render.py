@@ -14,8 +14,10 @@ the sky radiance along their own ray. Two methods:
 - ``method="direct"``: ``apparent_radiance`` at every sea pixel (the baseline; slow).
 
 What a scene does not need is left out (measured by ``pipelines/bench_render.py``): no sky work
-when no pixel sees sky; no azimuth dimension when the slopes are isotropic; table nodes only over
-the angles the sea pixels span; the model under ``torch.no_grad`` when nothing requires grad.
+when no pixel sees sky; no azimuth dimension (and no per-pixel azimuth) when the slopes are
+isotropic; table nodes only over the angles the sea pixels span; no autograd graph when nothing
+requires grad; per-pixel temporaries for ``chunk`` images at a time (a batch of 64 512×640 images
+fits in a few times its output).
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ from kornia.geometry.camera import PinholeCamera
 
 from ._validation import check_finite_range
 from .expectation import Quadrature, apparent_radiance, reflection_terms
-from .geometry import EARTH_RADIUS_M, ViewGeometry, view_geometry
+from .geometry import EARTH_RADIUS_M, CameraGeometry, ViewGeometry, view_geometry
 from .optics import band_refractive_index, split_refractive_index
 from .radiometry import LWIR, SpectralBand, as_band, band_radiance, brightness_temperature
 from .sky import ConstantSky, TabulatedSky, as_sky
@@ -157,12 +159,22 @@ class TableSize:
         zenith: nodes in ζ = asinh(cos θ̂/ε).
         azimuth: nodes in relative azimuth (anisotropic slopes only).
         fine_zenith, fine_azimuth: rows/columns of the fine table read by ``grid_sample``.
+        span: ``"pixels"`` (default): nodes only over the angles the image's sea pixels span;
+            ``"full"``: over every angle (θ̂ in [0°, 90°], every azimuth), for comparison.
     """
 
     zenith: int = 25
     azimuth: int = 9
     fine_zenith: int = 4096
     fine_azimuth: int = 128
+    span: str = "pixels"
+
+    def __post_init__(self) -> None:
+        if self.span not in ("pixels", "full"):
+            raise ValueError(f"TableSize.span must be 'pixels' or 'full'; got {self.span!r}")
+        for name in ("zenith", "azimuth", "fine_zenith", "fine_azimuth"):
+            if int(getattr(self, name)) < 2:
+                raise ValueError(f"TableSize.{name} must be >= 2")
 
 
 _EXT = 2  # fine cells beyond each end of the node interval, so no pixel reads the clamped border
@@ -251,6 +263,7 @@ def render(
     table: TableSize = TableSize(),
     quadrature: Quadrature | None = None,
     geometry: ViewGeometry | None = None,
+    chunk: int = 4,
 ) -> torch.Tensor:
     """Render infrared images of the sea seen by a batch of kornia cameras.
 
@@ -264,6 +277,8 @@ def render(
         table: node counts of the table method.
         quadrature: accuracy control of the model (default for the dtype).
         geometry: a precomputed :func:`view_geometry` of these cameras (reused across scenes).
+        chunk: images whose per-pixel temporaries are held at once (memory bound; the model is
+            evaluated for the whole batch in one call).
 
     Returns:
         (B, 1, H, W) tensor in the cameras' dtype and device; differentiable with respect to every
@@ -273,21 +288,33 @@ def render(
         raise ValueError(f"method must be 'table' or 'direct'; got {method!r}")
     if output not in ("radiance", "brightness_temperature"):
         raise ValueError(f"output must be 'radiance' or 'brightness_temperature'; got {output!r}")
-    geom = geometry if geometry is not None else view_geometry(cameras, earth_radius_m)
-    B, H, W = geom.is_sea.shape
-    dtype, device = geom.view_zenith.dtype, geom.view_zenith.device
+    if geometry is not None:
+        B, H, W = geometry.is_sea.shape
+        dtype, device = geometry.cos_view_zenith.dtype, geometry.cos_view_zenith.device
+    else:
+        cg = CameraGeometry(cameras, earth_radius_m)
+        B, H, W, dtype, device = cg.batch_size, cg.H, cg.W, cg.dtype, cg.device
     p = scene.resolved(B, dtype, device)
     q = quadrature or Quadrature.default(dtype)
-    sea = geom.is_sea
-    any_sky, any_sea = bool((~sea).any()), bool(sea.any())
-    img = None
-    if any_sea:
-        img = _sea_direct(geom, p, scene, q) if method == "direct" else _sea_table(geom, p, scene, q, table)
-    if any_sky:  # sky pixels: the sky along their own ray; no sky work when no pixel sees sky
-        sky_pix = _sky_radiance_pixels(_sky_per_image(p["sky"], B, dtype, device, 0), geom.cos_view_zenith.reshape(B, -1))
-        sky_pix = sky_pix.reshape(B, H, W)
-        img = sky_pix if img is None else torch.where(sea, img, sky_pix)
-    img = img.reshape(B, 1, H, W)
+    if method == "direct":
+        geom = geometry if geometry is not None else view_geometry(cameras, earth_radius_m)
+        sea = geom.is_sea
+        img = None
+        if bool(sea.any()):
+            img = _sea_direct(geom, p, scene, q)
+        if bool((~sea).any()):
+            sky_pix = _sky_pixels(p["sky"], geom.cos_view_zenith, B, dtype, device)
+            img = sky_pix if img is None else torch.where(sea, img, sky_pix)
+        img = img.reshape(B, 1, H, W)
+    else:
+        if geometry is not None:
+            g = geometry
+
+            def source(sl: slice) -> dict[str, torch.Tensor]:
+                return {"cos": g.cos_view_zenith[sl], "sea": g.is_sea[sl], "dx": g._dx[sl], "dy": g._dy[sl]}
+        else:
+            source = cg.pixels
+        img = _render_table(source, B, H, W, dtype, device, p, scene, q, table, chunk)[:, None]
     if output == "brightness_temperature":
         return brightness_temperature(img.clamp_min(torch.finfo(dtype).tiny), scene.band)
     return img
@@ -317,65 +344,119 @@ def _sea_direct(geom: ViewGeometry, p: dict[str, Any], scene: SeaScene, q: Quadr
     return out.index_put((sea,), vals)
 
 
-def _sea_table(
-    geom: ViewGeometry, p: dict[str, Any], scene: SeaScene, q: Quadrature, table: TableSize
+def _sky_pixels(sky: Any, cos_z: torch.Tensor, B: int, dtype: torch.dtype, device: torch.device) -> torch.Tensor:
+    """Sky radiance along each pixel's ray (b, H, W) for a chunk whose first image is image 0 of
+    ``sky``'s batch (callers slice per-image skies)."""
+    b, H, W = cos_z.shape
+    return _sky_radiance_pixels(_sky_per_image(sky, b, dtype, device, 0), cos_z.reshape(b, -1)).reshape(b, H, W)
+
+
+def _slice_sky(sky: Any, sl: slice) -> Any:
+    if isinstance(sky, TabulatedSky) and sky.radiance.ndim > 1:
+        return sky.with_radiance(sky.radiance[sl])
+    if isinstance(sky, ConstantSky) and torch.as_tensor(sky.radiance).ndim > 0:
+        return ConstantSky(torch.as_tensor(sky.radiance)[sl])
+    return sky
+
+
+def _render_table(
+    source: Callable[[slice], dict[str, torch.Tensor]],
+    B: int,
+    H: int,
+    W: int,
+    dtype: torch.dtype,
+    device: torch.device,
+    p: dict[str, Any],
+    scene: SeaScene,
+    q: Quadrature,
+    table: TableSize,
+    chunk: int,
 ) -> torch.Tensor:
-    B, H, W = geom.is_sea.shape
-    dtype, device = geom.view_zenith.dtype, geom.view_zenith.device
-    sea = geom.is_sea
+    """The table method, streaming ``chunk`` images at a time: pass 1 keeps only each pixel's table
+    coordinates (and sky radiance, where sky is seen) and the per-image angle ranges; the model is
+    evaluated once for the batch; pass 2 samples the tables chunk by chunk. Returns (B, H, W)."""
     iso = bool(((p["vx"] == p["vy"]) & (p["cxy"] == 0)).all())
     # ε: a quarter of the smallest rms slope of each image, so ζ resolves the grazing layer.
     lam_min = 0.5 * (p["vx"] + p["vy"] - torch.sqrt((p["vx"] - p["vy"]) ** 2 + 4 * p["cxy"] ** 2))
     eps = (0.25 * torch.sqrt(lam_min.detach().clamp_min(0.0))).clamp(1e-4, 0.05).double()
-    # the pixel coordinate in ζ, from the pixel's own cos θ̂ in the render dtype
-    eps_t = eps.to(dtype)[:, None, None]
-    zeta_pix = torch.asinh(geom.cos_view_zenith.clamp_min(0.0) / eps_t)
+    eps_t = eps.to(dtype)
     nz, nphi = table.zenith, (1 if iso else table.azimuth)
     xz, Lz, ez = _lobatto_interp(nz, table.fine_zenith)
     xp, Lp, ep = _lobatto_interp(nphi, 1 if iso else table.fine_azimuth)
-    any_sea = sea.flatten(1).any(1)
-    lo, hi = _masked_range(zeta_pix, sea)
-    lo = torch.where(any_sea, lo, torch.zeros_like(lo)).double()
-    hi = torch.where(any_sea, hi, torch.ones_like(hi)).double()
+    chunks = []
+    zlo, zhi, olo, ohi, centre = [], [], [], [], []
+    for i in range(0, B, chunk):
+        sl = slice(i, min(i + chunk, B))
+        px = source(sl)
+        sea = px["sea"]
+        zeta = torch.asinh(px["cos"].clamp_min(0.0) / eps_t[sl, None, None])  # the pixel's own cos θ̂
+        lo, hi = _masked_range(zeta, sea)
+        zlo.append(lo)
+        zhi.append(hi)
+        entry: dict[str, Any] = {"sl": sl, "sea": sea, "zeta": zeta, "sky": None}
+        if not iso:
+            phi = torch.atan2(-px["dy"], -px["dx"]) - p["wind_direction"][sl, None, None]
+            c, o = _azimuth_offsets(phi, sea)
+            a, b = _masked_range(o, sea)
+            centre.append(c)
+            olo.append(a)
+            ohi.append(b)
+            entry["o"] = o
+        if bool((~sea).any()):  # no sky work when no pixel of the chunk sees sky
+            entry["sky"] = _sky_pixels(_slice_sky(p["sky"], sl), px["cos"], sl.stop - sl.start, dtype, device)
+        del px
+        chunks.append(entry)
+    any_sea = torch.cat([torch.isfinite(z) for z in zlo])
+    lo = torch.where(any_sea, torch.cat(zlo), torch.zeros(B, dtype=dtype, device=device)).double()
+    hi = torch.where(any_sea, torch.cat(zhi), torch.ones(B, dtype=dtype, device=device)).double()
+    if table.span == "full":
+        lo, hi = torch.zeros_like(lo), torch.asinh(1.0 / eps)
     pad = torch.clamp(1e-6 * (hi - lo), min=1e-9)
     lo, hi = lo - pad, hi + pad
     xz_t = torch.as_tensor(xz, dtype=torch.float64, device=device)
     zeta_n = lo[:, None] + (hi - lo)[:, None] * (xz_t + 1) / 2  # (B, nz)
-    gy = (2.0 * (zeta_pix - lo.to(dtype)[:, None, None]) / (hi - lo).to(dtype)[:, None, None] - 1.0) / (1.0 + ez)
+    th_nodes = torch.acos((eps[:, None] * torch.sinh(zeta_n)).clamp(0.0, 1.0)).to(dtype)
     if iso:
         ph_nodes = torch.zeros(B, 1, dtype=dtype, device=device)
-        gx = torch.zeros_like(gy)
     else:
-        c, o = _azimuth_offsets(_relative_azimuth(geom, p), sea)
-        olo, ohi = _masked_range(o, sea)
-        olo = torch.where(any_sea, olo, torch.zeros_like(olo)).double()
-        ohi = torch.where(any_sea, ohi, torch.ones_like(ohi)).double()
-        pad = torch.clamp(1e-6 * (ohi - olo), min=1e-6)
-        olo, ohi = olo - pad, ohi + pad
+        c = torch.cat(centre).double()
+        a = torch.where(any_sea, torch.cat(olo), torch.zeros(B, dtype=dtype, device=device)).double()
+        b = torch.where(any_sea, torch.cat(ohi), torch.ones(B, dtype=dtype, device=device)).double()
+        if table.span == "full":
+            a, b = torch.full_like(a, -math.pi / 2), torch.full_like(b, math.pi / 2)
+        pad = torch.clamp(1e-6 * (b - a), min=1e-6)
+        a, b = a - pad, b + pad
         xp_t = torch.as_tensor(xp, dtype=torch.float64, device=device)
-        ph_nodes = (c.double()[:, None] + olo[:, None] + (ohi - olo)[:, None] * (xp_t + 1) / 2).to(dtype)
-        gx = (2.0 * (o - olo.to(dtype)[:, None, None]) / (ohi - olo).to(dtype)[:, None, None] - 1.0) / (1.0 + ep)
-    th_nodes = torch.acos((eps[:, None] * torch.sinh(zeta_n)).clamp(0.0, 1.0)).to(dtype)
+        ph_nodes = (c[:, None] + a[:, None] + (b - a)[:, None] * (xp_t + 1) / 2).to(dtype)
     vz = th_nodes[:, :, None].expand(B, nz, nphi)
     va = ph_nodes[:, None, :].expand(B, nz, nphi)
     slopes = SlopeStatistics.from_variances(p["vx"][:, None, None], p["vy"][:, None, None], p["cxy"][:, None, None])
     sky = _sky_per_image(p["sky"], B, dtype, device, 2)
-    needs_grad = torch.is_grad_enabled() and any(
-        isinstance(v, torch.Tensor) and v.requires_grad for v in (p["vx"], p["vy"], p["cxy"], p["n"], p["k"])
-    ) or (isinstance(sky, TabulatedSky) and sky.radiance.requires_grad)
-    with torch.set_grad_enabled(needs_grad):
-        t_s, t_rho = reflection_terms(
-            vz, va, slopes, (p["n"][:, None, None], p["k"][:, None, None]), sky, scene.shadowing, q
-        )
+    t_s, t_rho = reflection_terms(vz, va, slopes, (p["n"][:, None, None], p["k"][:, None, None]), sky, scene.shadowing, q)
     rb = p["rb"][:, None, None]
     coarse = rb - rb * t_rho + t_s  # R_a at the nodes (B, nz, nphi); linear in the node values
     Lz_t = torch.as_tensor(Lz, dtype=dtype, device=device)
     Lp_t = torch.as_tensor(Lp, dtype=dtype, device=device)
     fine = torch.einsum("iz,bzp,jp->bij", Lz_t, coarse, Lp_t)[:, None]  # (B, 1, Mz, Mp)
-    grid = torch.stack([gx, gy], -1)  # (B, H, W, 2): x = azimuth, y = ζ
-    # bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges only
-    # to first order; bilinear on the fine table is second order (~1e-7 at 4096 rows).
-    return F.grid_sample(fine, grid, mode="bilinear", padding_mode="border", align_corners=True)[:, 0]
+    lo_t, span_z = lo.to(dtype), (hi - lo).to(dtype)
+    if not iso:
+        a_t, span_p = a.to(dtype), (b - a).to(dtype)
+    out = []
+    while chunks:
+        e = chunks.pop(0)
+        sl = e["sl"]
+        gy = (2.0 * (e["zeta"] - lo_t[sl, None, None]) / span_z[sl, None, None] - 1.0) / (1.0 + ez)
+        if iso:
+            gx = torch.zeros_like(gy)
+        else:
+            gx = (2.0 * (e["o"] - a_t[sl, None, None]) / span_p[sl, None, None] - 1.0) / (1.0 + ep)
+        # bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges
+        # only to first order; bilinear on the fine table is second order (~1e-7 at 4096 rows).
+        vals = F.grid_sample(fine[sl], torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border", align_corners=True)[:, 0]
+        if e["sky"] is not None:
+            vals = torch.where(e["sea"], vals, e["sky"])
+        out.append(vals)
+    return torch.cat(out) if len(out) > 1 else out[0]
 
 
 class SeaRenderer(torch.nn.Module):
