@@ -12,7 +12,7 @@ from typing import Any
 
 import torch
 
-__all__ = ["resolve_dtype_device", "as_tensor", "check_finite_range", "check_same_device"]
+__all__ = ["resolve_dtype_device", "as_tensor", "check_finite_range", "check_same_device", "per_batch"]
 
 
 def _tensors(items: dict[str, Any]) -> dict[str, torch.Tensor]:
@@ -58,6 +58,16 @@ def as_tensor(x: Any, dtype: torch.dtype, device: torch.device) -> torch.Tensor:
     if isinstance(x, torch.Tensor):
         return x.to(dtype=dtype, device=device)
     return torch.as_tensor(x, dtype=dtype, device=device)
+
+
+def per_batch(name: str, x: Any, n: int, dtype: torch.dtype, device: torch.device | None) -> torch.Tensor:
+    """A float or a tensor of shape () or (n,) as a tensor of shape (n,): one value per image."""
+    t = x.to(dtype=dtype, device=device) if isinstance(x, torch.Tensor) else torch.tensor(float(x), dtype=dtype, device=device)
+    if t.ndim == 0:
+        return t.expand(n)
+    if t.shape != (n,):
+        raise ValueError(f"{name}: must be a float or a tensor of shape (B,) = ({n},); got {tuple(t.shape)}")
+    return t
 
 
 def _values(x: Any) -> torch.Tensor:

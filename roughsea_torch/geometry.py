@@ -15,20 +15,11 @@ import torch
 from kornia.geometry.camera import PinholeCamera
 from kornia.geometry.depth import unproject_meshgrid
 
-from ._validation import check_finite_range
+from ._validation import check_finite_range, per_batch
 
 __all__ = ["EARTH_RADIUS_M", "make_camera", "ViewGeometry", "view_geometry", "CameraGeometry"]
 
 EARTH_RADIUS_M = 6_371_000.0
-
-
-def _batch(x: Any, n: int, dtype: torch.dtype, device: torch.device | None) -> torch.Tensor:
-    t = x.to(dtype=dtype, device=device) if isinstance(x, torch.Tensor) else torch.tensor(float(x), dtype=dtype, device=device)
-    if t.ndim == 0:
-        return t.expand(n)
-    if t.shape != (n,):
-        raise ValueError(f"pose arguments must be floats or tensors of shape (B,) = ({n},); got {tuple(t.shape)}")
-    return t
 
 
 def make_camera(
@@ -84,11 +75,11 @@ def make_camera(
     check_finite_range("roll_deg", roll_deg, -180.0, 180.0, unit="deg")
     B = batch_size
     d2r = math.pi / 180.0
-    hfov = _batch(hfov_deg, B, dtype, device) * d2r
-    alt = _batch(altitude_m, B, dtype, device)
-    p = _batch(pitch_deg, B, dtype, device) * d2r
-    y = _batch(yaw_deg, B, dtype, device) * d2r
-    r = _batch(roll_deg, B, dtype, device) * d2r
+    hfov = per_batch("hfov_deg", hfov_deg, B, dtype, device) * d2r
+    alt = per_batch("altitude_m", altitude_m, B, dtype, device)
+    p = per_batch("pitch_deg", pitch_deg, B, dtype, device) * d2r
+    y = per_batch("yaw_deg", yaw_deg, B, dtype, device) * d2r
+    r = per_batch("roll_deg", roll_deg, B, dtype, device) * d2r
     zero, one = torch.zeros_like(p), torch.ones_like(p)
     # camera axes in world coordinates
     fwd = torch.stack([torch.cos(p) * torch.cos(y), torch.cos(p) * torch.sin(y), torch.sin(p)], -1)

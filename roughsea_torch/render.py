@@ -32,7 +32,7 @@ import torch
 import torch.nn.functional as F
 from kornia.geometry.camera import PinholeCamera
 
-from ._validation import check_finite_range
+from ._validation import check_finite_range, per_batch
 from .expectation import Quadrature, apparent_radiance, reflection_terms
 from .geometry import EARTH_RADIUS_M, CameraGeometry, ViewGeometry, view_geometry
 from .optics import band_refractive_index, split_refractive_index
@@ -41,15 +41,6 @@ from .sky import ConstantSky, TabulatedSky, as_sky
 from .slopes import SlopeStatistics
 
 __all__ = ["SeaScene", "render", "SeaRenderer", "TableSize"]
-
-
-def _per_image(name: str, x: Any, B: int, dtype: torch.dtype, device: torch.device) -> torch.Tensor:
-    t = x.to(dtype=dtype, device=device) if isinstance(x, torch.Tensor) else torch.tensor(float(x), dtype=dtype, device=device)
-    if t.ndim == 0:
-        return t.expand(B)
-    if t.shape != (B,):
-        raise ValueError(f"{name}: scene fields are floats or tensors of shape (B,) = ({B},); got {tuple(t.shape)}")
-    return t
 
 
 class SeaScene:
@@ -135,13 +126,13 @@ class SeaScene:
         own = self.batch_size
         if own not in (1, B):
             raise ValueError(f"SeaScene has batch size {own} but the cameras have {B}")
-        vx, vy, cxy = (_per_image("slopes", v, B, dtype, device) for v in self.slopes.tensors(dtype, device))
-        wd = _per_image("wind_direction", self.wind_direction, B, dtype, device)
+        vx, vy, cxy = (per_batch("slopes", v, B, dtype, device) for v in self.slopes.tensors(dtype, device))
+        wd = per_batch("wind_direction", self.wind_direction, B, dtype, device)
         if self.sea_radiance is not None:
-            rb = _per_image("sea_radiance", self.sea_radiance, B, dtype, device)
+            rb = per_batch("sea_radiance", self.sea_radiance, B, dtype, device)
             t_ref: Any = 300.0
         else:
-            t_sea = _per_image("sea_temperature", self.sea_temperature, B, dtype, device)
+            t_sea = per_batch("sea_temperature", self.sea_temperature, B, dtype, device)
             rb = band_radiance(t_sea, self.band)
             t_ref = t_sea.detach()
         m = self.refractive_index
