@@ -250,3 +250,17 @@ def test_water_index_interpolates_the_table():
     assert abs(m[1].real.item() - (n[i - 1] * (1 - f) + n[i] * f)) < 1e-12
     with pytest.raises(ValueError, match="wavelength"):
         rs.water_refractive_index(1e-6)
+
+
+@pytest.mark.parametrize("band, tol", [((8e-6, 12e-6), 1.5e-4), ((3e-6, 5e-6), 5e-4)])
+def test_band_refractive_index_fit_reproduces_band_averaged_reflectance(band, tol):
+    """The default effective index reproduces the Planck-weighted band average of ρ(θ) at every
+    angle far better than the paper's averaged (n, k) does in the LWIR (physics.md §5)."""
+    c = torch.cos(torch.deg2rad(torch.linspace(0.0, 89.5, 120, dtype=torch.float64)))
+    target = rs.band_reflectance(c, band, 290.0)
+    fit = (rs.fresnel_reflectance(c, rs.band_refractive_index(band, 290.0)) - target).abs().max()
+    avg = (rs.fresnel_reflectance(c, rs.band_refractive_index(band, 290.0, method="average")) - target).abs().max()
+    assert fit <= tol
+    assert fit <= avg
+    if band[0] == 8e-6:
+        assert avg > 20 * fit
