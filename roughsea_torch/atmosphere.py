@@ -78,6 +78,7 @@ ATMOSPHERES = (
 )
 EARTH_RADIUS_M = 6_371_000.0  # the Earth radius of the path tables (physics.md §8)
 DATA_DIR = Path(__file__).resolve().parent / "data" / "lowtran"
+_TAU_FLOOR = 1e-9  # band transmittances below this (opaque bands, long paths) are held at it
 
 # Interpolation of the path tables (chosen by the held-out errors printed by the generator).
 _PATH_MODE = "bilinear"
@@ -333,13 +334,14 @@ class AtmosphericPath:
     longer line of sight passes above the horizon and never meets the sea); anything else raises
     ``ValueError`` unless ``clamp=True``, which clamps h into its range and r into [h, r_hor(h)].
 
-    Interpolation: bilinear (``torch.nn.functional.grid_sample``) in the coordinates
-    (altitude, u), u = log(r/h) / log(r_hor/h) (uniform nodes), the altitude being mapped to its
-    fractional node index piecewise linearly in log h (below 1 km) or in log(h − L + 0.5 m) above a
-    LOWTRAN level L (1, 2, 3, 4 km), where LOWTRAN's layer-mean emission makes the path radiance jump
-    (by up to 2 % in MWIR, within 0.1 m) and then vary steeply. The interpolated quantities are
-    log(−log τ) and log(L / (1 − τ)), nearly linear in these coordinates (optical depth ∝ r, path
-    radiance ≈ (1 − τ) × a slowly varying source radiance). Held-out errors: :func:`provenance`.
+    Interpolation: bilinear (``torch.nn.functional.grid_sample``) in (altitude, u) with
+    u = log(r/h) / log(r_hor/h) (uniform nodes). The interpolated quantities are log(−log τ) and
+    log(L / (1 − τ)), nearly linear in these coordinates (optical depth ∝ r; path radiance ≈
+    (1 − τ) × a slowly varying source radiance). The altitude maps to its fractional node index
+    piecewise linearly in log h; for the path radiance, in the cells above a LOWTRAN level L (1, 2, 3,
+    4 km), in log(h − L + 3 m) instead: LOWTRAN's layer-mean emission makes its path radiance jump at
+    each level (by up to 2 % in MWIR) and vary steeply for ~100 m above it; within 3 m above a level
+    the table bridges that jump linearly. Held-out errors: :func:`provenance`.
     """
 
     def __init__(self, name: str, band: SpectralBand, tau: np.ndarray, radiance: np.ndarray,
@@ -378,21 +380,25 @@ class AtmosphericPath:
             has_lev = ~np.isnan(self._lev)
             self._cache[key] = (f(self._table), torch.as_tensor(self._h, dtype=torch.float64, device=device),
                                 f(np.nan_to_num(self._lev)), torch.as_tensor(has_lev, device=device),
-                                f(self._g0), f(self._g1))
+                                f(self._g0), f(self._g1), f(np.log(self._h[:-1])), f(np.log(self._h[1:])))
         return self._cache[key]
 
     def horizon_range(self, altitude_m: Any) -> Any:
         """√(2 h R + h²) [m]: the longest range at which a line of sight from h meets the sea."""
         return horizon_range(altitude_m)
 
-    def _altitude_index(self, h: torch.Tensor, dtype: torch.dtype, device: torch.device) -> torch.Tensor:
-        """Fractional node index of altitudes h (differentiable, piecewise linear in the cell's
-        coordinate)."""
-        _, nodes, lev, has_lev, g0, g1 = self._tensors(dtype, device)
+    def _altitude_index(self, h: torch.Tensor, dtype: torch.dtype, device: torch.device,
+                        levels: bool) -> torch.Tensor:
+        """Fractional node index of altitudes h, piecewise linear in log h, or (``levels``) in
+        log(h − L + c) in the cells above a LOWTRAN level L. Differentiable in h."""
+        _, nodes, lev, has_lev, g0, g1, l0, l1 = self._tensors(dtype, device)
         i = torch.searchsorted(nodes, h.detach().double().contiguous(), right=True).clamp(1, nodes.numel() - 1) - 1
-        lv, hl = lev[i], has_lev[i]
-        g = torch.where(hl, torch.log((h - lv).clamp_min(0.0) + self._offset), torch.log(h))
-        t = (g - g0[i]) / (g1[i] - g0[i])
+        if levels:
+            hl = has_lev[i]
+            g = torch.where(hl, torch.log((h - lev[i]).clamp_min(0.0) + self._offset), torch.log(h))
+            t = (g - g0[i]) / (g1[i] - g0[i])
+        else:
+            t = (torch.log(h) - l0[i]) / (l1[i] - l0[i])
         return i.to(dtype) + t
 
     def __call__(self, altitude_m: Any, range_m: Any, *, clamp: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
@@ -436,10 +442,13 @@ class AtmosphericPath:
         n_h = table.shape[-2]
         # u = log(r/h) / log(r_hor/h); at the 2 m - 5 km of the tables log(r_hor/h) >= 3.9
         u = torch.log(r / h) / torch.log(horizon_range(h) / h)
-        gy = self._altitude_index(h.reshape(-1), dtype, device) * (2.0 / (n_h - 1)) - 1.0
         gx = u.reshape(-1) * 2.0 - 1.0
-        grid = torch.stack([gx, gy], dim=-1).reshape(1, 1, -1, 2)
-        out = F.grid_sample(table, grid, mode="bilinear", padding_mode="border", align_corners=True)[0, :, 0, :]
+        out = []
+        for c, levels in ((0, False), (1, True)):  # log optical depth; log source radiance
+            gy = self._altitude_index(h.reshape(-1), dtype, device, levels) * (2.0 / (n_h - 1)) - 1.0
+            grid = torch.stack([gx, gy], dim=-1).reshape(1, 1, -1, 2)
+            out.append(F.grid_sample(table[:, c:c + 1], grid, mode="bilinear", padding_mode="border",
+                                     align_corners=True).reshape(-1))
         depth = torch.exp(out[0])
         tau = torch.exp(-depth).reshape(shape)
         rad = (torch.exp(out[1]) * -torch.expm1(-depth)).reshape(shape)
@@ -478,13 +487,16 @@ def load_path(
     t = _tables(name, data_dir)
     b = _band(band, response, name, data_dir)
     dt = _dtype(dtype)
-    t_ref = t["surface_air_temperature_K"] if reference_temperature is None else reference_temperature
+    t_ref = float(t["surface_air_temperature_K"]) if reference_temperature is None else reference_temperature
     if not (isinstance(t_ref, (int, float, np.floating)) and math.isfinite(float(t_ref)) and float(t_ref) > 0):
         raise ValueError(f"reference_temperature must be a temperature > 0 K, got {reference_temperature!r}")
     tau, rad = _band_path(t, b, float(t_ref))
-    if not (np.all((tau > 0) & (tau < 1)) and np.all(rad > 0)):
-        raise ValueError("band/response: the band transmittance or path radiance is degenerate here "
-                         "(transmittance must be in (0, 1) and path radiance > 0 at every node); widen the band")
+    # The stored spectra are accurate to ~5e-4 in τ (see provenance): an opaque band can come out
+    # at or below 0; such transmittances are held at 1e-9 (the interpolation works on log(−log τ)).
+    tau = np.clip(tau, _TAU_FLOOR, 1.0 - 1e-9)
+    if not np.all(rad > 0):
+        raise ValueError("band/response: the band path radiance is not > 0 at every node of the table; "
+                         "widen the band or check the response")
     return AtmosphericPath(name, b, tau, rad, t["path_altitude_m"].astype(np.float64),
                            t["path_u"].astype(np.float64), t["path_levels_m"], float(t["path_level_offset_m"]),
                            float(t_ref), dt, device)
