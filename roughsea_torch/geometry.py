@@ -122,6 +122,7 @@ class ViewGeometry:
             (sky pixels) [rad], from +x towards +y, in (−π, π].
         is_sea: the ray meets the sea.
         range_m: slant range to the sea [m] (inf for sky pixels).
+        altitude_m: (B,) altitude of each camera above the sea [m].
 
     ``view_zenith``, ``view_azimuth`` and ``range_m`` are computed on first access (a renderer of
     isotropic seas never needs the azimuth, nor one without a path model the range).
@@ -178,7 +179,9 @@ def view_geometry(
     parts = [geo.pixels(slice(i, i + chunk)) for i in range(0, geo.batch_size, chunk)]
     cat = lambda k: torch.cat([p[k] for p in parts]) if len(parts) > 1 else parts[0][k]  # noqa: E731
     cz, sea, dz = cat("cos"), cat("sea"), cat("dz")
-    return ViewGeometry(cz, sea, cat("dx"), cat("dy"), lambda: geo.slant_range(cz, sea, dz))
+    out = ViewGeometry(cz, sea, cat("dx"), cat("dy"), lambda: geo.slant_range(cz, sea, dz))
+    out.altitude_m = geo.alt.to(geo.dtype)
+    return out
 
 
 class CameraGeometry:
@@ -236,11 +239,11 @@ class CameraGeometry:
             cos_t = self.k_r[sl, None, None] * torch.sqrt(((-dz - sh) * (-dz + sh)).clamp_min(0.0))  # √(b² − c)/R
         return {"cos": torch.where(sea, cos_t, dz), "sea": sea, "dx": dx, "dy": dy, "dz": dz}
 
-    def slant_range(self, cz: torch.Tensor, sea: torch.Tensor, dz: torch.Tensor) -> torch.Tensor:
-        """Slant range [m] to the sea (inf for sky pixels) from a full batch's ``pixels`` output."""
+    def slant_range(self, cz: torch.Tensor, sea: torch.Tensor, dz: torch.Tensor, sl: slice = slice(None)) -> torch.Tensor:
+        """Slant range [m] to the sea (inf for sky pixels) from ``pixels(sl)``'s output."""
         if self.flat:
-            rng = self.alt.to(self.dtype)[:, None, None] / torch.where(sea, -dz, torch.ones_like(dz))
+            rng = self.alt.to(self.dtype)[sl, None, None] / torch.where(sea, -dz, torch.ones_like(dz))
         else:  # c / (√(b² − c) − b) = h(2R + h)/(R + h) / (√(dz² − s_h²) − dz)
-            root = cz / self.k_r[:, None, None]
-            rng = self.num[:, None, None] / torch.where(sea, root - dz, torch.ones_like(dz))
+            root = cz / self.k_r[sl, None, None]
+            rng = self.num[sl, None, None] / torch.where(sea, root - dz, torch.ones_like(dz))
         return torch.where(sea, rng, torch.full_like(rng, math.inf))

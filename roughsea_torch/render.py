@@ -60,6 +60,15 @@ class SeaScene:
         refractive_index: sea index n + i k; default: water (Hale & Querry) averaged over the band
             with Planck(T_sea) × response weights (the paper's choice).
         shadowing: Eq. 5 (True) or Eq. 7.
+        path: the air between sea and sensor: radiance at the sensor = τ · R_a + L_path per sea pixel,
+            from its slant range and the camera's altitude (``roughsea_torch.atmosphere.load_path``;
+            altitudes and ranges outside the tables are clamped to them). ``None`` (default): on
+            whenever ``sky`` is a named atmosphere, off otherwise; ``False``: off; ``True`` or a name
+            or an ``AtmosphericPath``: on. On by default because it matters at every range a sea
+            scene spans: LWIR midlatitude summer from 20 m, τ = 0.95 at 100 m, 0.75 at 1 km, 0.05 at
+            the 16 km horizon, shifting a 290 K sea by +0.2 K, +1.1 K, +4.0 K (more than a typical
+            NETD of 0.05 K beyond ~20 m). Sky pixels see the sky table along their own ray (from
+            sea level: for a high sensor the sky above it is somewhat colder; not modelled).
 
     Example:
         >>> scene = SeaScene(wind_speed=torch.tensor([3.0, 12.0]), wind_direction=0.5,
@@ -82,6 +91,7 @@ class SeaScene:
         sky: Any = "midlatitude_summer",
         refractive_index: Any = None,
         shadowing: bool = True,
+        path: Any = None,
     ):
         if (slopes is None) == (wind_speed is None):
             raise ValueError("SeaScene: give exactly one of slopes= or wind_speed=")
@@ -103,7 +113,25 @@ class SeaScene:
         self.sea_temperature = sea_temperature
         self.sea_radiance = sea_radiance
         self.band: SpectralBand = as_band(band, response)
+        self.atmosphere = sky if isinstance(sky, str) else None
+        if self.atmosphere is not None:  # a shipped LOWTRAN7 atmosphere, integrated over this band
+            from .atmosphere import load_sky
+
+            sky = load_sky(self.atmosphere, (self.band.lo, self.band.hi), self.band.response, dtype=torch.float64)
         self.sky = as_sky(sky)
+        if path is None:
+            path = self.atmosphere is not None
+        if path is True:
+            if self.atmosphere is None:
+                raise ValueError("path=True needs a named atmosphere: give sky='<name>' or path='<name>'")
+            path = self.atmosphere
+        if isinstance(path, str):
+            from .atmosphere import load_path
+
+            path = load_path(path, (self.band.lo, self.band.hi), self.band.response, dtype=torch.float64)
+        if path is not False and not callable(path):
+            raise ValueError(f"path must be None, a bool, an atmosphere name or an AtmosphericPath; got {path!r}")
+        self.path = path or None
         self.refractive_index = refractive_index
         self.shadowing = shadowing
 
@@ -293,6 +321,8 @@ def render(
         img = None
         if bool(sea.any()):
             img = _sea_direct(geom, p, scene, q)
+            if scene.path is not None:
+                img = _apply_path(scene.path, img, geom.altitude_m, geom.range_m, sea)
         if bool((~sea).any()):
             sky_pix = _sky_pixels(p["sky"], geom.cos_view_zenith, B, dtype, device)
             img = sky_pix if img is None else torch.where(sea, img, sky_pix)
@@ -302,10 +332,22 @@ def render(
             g = geometry
 
             def source(sl: slice) -> dict[str, torch.Tensor]:
-                return {"cos": g.cos_view_zenith[sl], "sea": g.is_sea[sl], "dx": g._dx[sl], "dy": g._dy[sl]}
+                out = {"cos": g.cos_view_zenith[sl], "sea": g.is_sea[sl], "dx": g._dx[sl], "dy": g._dy[sl]}
+                if scene.path is not None:
+                    out["range"] = g.range_m[sl]
+                return out
+
+            altitude = g.altitude_m
         else:
-            source = cg.pixels
-        img = _render_table(source, B, H, W, dtype, device, p, scene, q, table, chunk)[:, None]
+
+            def source(sl: slice) -> dict[str, torch.Tensor]:
+                out = cg.pixels(sl)
+                if scene.path is not None:
+                    out["range"] = cg.slant_range(out["cos"], out["sea"], out["dz"], sl)
+                return out
+
+            altitude = cg.alt.to(dtype)
+        img = _render_table(source, B, H, W, dtype, device, p, scene, q, table, chunk, altitude)[:, None]
     if output == "brightness_temperature":
         return brightness_temperature(img.clamp_min(torch.finfo(dtype).tiny), scene.band)
     return img
@@ -342,6 +384,14 @@ def _sky_pixels(sky: Any, cos_z: torch.Tensor, B: int, dtype: torch.dtype, devic
     return _sky_radiance_pixels(_sky_per_image(sky, b, dtype, device, 0), cos_z.reshape(b, -1)).reshape(b, H, W)
 
 
+def _apply_path(path: Any, radiance: torch.Tensor, altitude: torch.Tensor, range_m: torch.Tensor, sea: torch.Tensor) -> torch.Tensor:
+    """τ · R_a + L_path at each sea pixel (other pixels unchanged); (b, H, W)."""
+    h = altitude.to(radiance.dtype)[:, None, None].expand_as(radiance)
+    r = torch.where(sea, range_m.to(radiance.dtype), h)  # any valid range off the sea
+    tau, lp = path(h, r, clamp=True)
+    return torch.where(sea, tau * radiance + lp, radiance)
+
+
 def _slice_sky(sky: Any, sl: slice) -> Any:
     if isinstance(sky, TabulatedSky) and sky.radiance.ndim > 1:
         return sky.with_radiance(sky.radiance[sl])
@@ -362,6 +412,7 @@ def _render_table(
     q: Quadrature,
     table: TableSize,
     chunk: int,
+    altitude: torch.Tensor,
 ) -> torch.Tensor:
     """The table method, streaming ``chunk`` images at a time: pass 1 keeps only each pixel's table
     coordinates (and sky radiance, where sky is seen) and the per-image angle ranges; the model is
@@ -384,7 +435,7 @@ def _render_table(
         lo, hi = _masked_range(zeta, sea)
         zlo.append(lo)
         zhi.append(hi)
-        entry: dict[str, Any] = {"sl": sl, "sea": sea, "zeta": zeta, "sky": None}
+        entry: dict[str, Any] = {"sl": sl, "sea": sea, "zeta": zeta, "sky": None, "range": px.get("range")}
         if not iso:
             phi = torch.atan2(-px["dy"], -px["dx"]) - p["wind_direction"][sl, None, None]
             c, o = _azimuth_offsets(phi, sea)
@@ -444,6 +495,8 @@ def _render_table(
         # bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges
         # only to first order; bilinear on the fine table is second order (~1e-7 at 4096 rows).
         vals = F.grid_sample(fine[sl], torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border", align_corners=True)[:, 0]
+        if scene.path is not None:
+            vals = _apply_path(scene.path, vals, altitude[sl], e["range"], e["sea"])
         if e["sky"] is not None:
             vals = torch.where(e["sea"], vals, e["sky"])
         out.append(vals)

@@ -195,3 +195,40 @@ def test_pixel_derivative_matches_finite_differences_per_pixel():
     fd = (bt(torch.tensor(8.001, dtype=torch.float64)) - bt(torch.tensor(7.999, dtype=torch.float64))) / 0.002
     torch.testing.assert_close(d, fd, rtol=1e-4, atol=1e-7)
     assert d.abs().max() > 0.05  # wind matters to these sea pixels
+
+
+class BeerLambertPath:
+    """A synthetic isothermal path: τ = exp(−r / 5 km), L = (1 − τ) B(T_air) (Kirchhoff)."""
+
+    def __init__(self, t_air: float):
+        self.l_air = float(rs.band_radiance(torch.tensor(t_air, dtype=torch.float64)))
+
+    def __call__(self, altitude_m, range_m, clamp=False):
+        tau = torch.exp(-range_m / 5000.0)
+        return tau, (1.0 - tau) * self.l_air
+
+
+def test_path_composes_transmittance_and_path_radiance_per_pixel():
+    """radiance at the sensor = τ(range) · R_a + L_path on every sea pixel; sky pixels unchanged;
+    far sea pixels tend to the air's brightness temperature."""
+    cams = rs.make_camera(40, 48, hfov_deg=3.0, altitude_m=20.0, pitch_deg=-0.5, dtype=torch.float64)
+    geom = rs.view_geometry(cams)
+    base = dict(wind_speed=6.0, sea_temperature=285.0, sky=sky)
+    off = rs.render(cams, rs.SeaScene(**base, path=False), geometry=geom)
+    on = rs.render(cams, rs.SeaScene(**base, path=BeerLambertPath(295.0)), geometry=geom)
+    tau = torch.exp(-geom.range_m / 5000.0)[:, None]
+    sea = geom.is_sea[:, None]
+    expected = tau * off + (1 - tau) * float(rs.band_radiance(torch.tensor(295.0, dtype=torch.float64)))
+    torch.testing.assert_close(on[sea], expected[sea], rtol=1e-12, atol=0)
+    assert torch.equal(on[~sea], off[~sea])
+    bt = rs.brightness_temperature(on)[sea]
+    far = (geom.range_m[:, None] > 12_000)[sea]
+    assert far.any() and (bt[far] > 294.0).all()  # τ < 0.1: mostly air
+
+
+def test_scene_path_arguments():
+    with pytest.raises(ValueError, match="path=True needs a named atmosphere"):
+        rs.SeaScene(wind_speed=3.0, sea_temperature=290.0, sky=1.0, path=True)
+    with pytest.raises(ValueError, match="path must be"):
+        rs.SeaScene(wind_speed=3.0, sea_temperature=290.0, sky=1.0, path=3.0)
+    assert rs.SeaScene(wind_speed=3.0, sea_temperature=290.0, sky=1.0).path is None  # no model for a custom sky
