@@ -39,6 +39,7 @@ def main() -> None:
     ap.add_argument("--states", type=int, default=16)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--ref-evals", type=int, default=12)
+    ap.add_argument("--dtypes", default="float32", help="comma-separated: float32,float64")
     ap.add_argument("--out", type=Path, default=Path("docs"))
     args = ap.parse_args()
     g = torch.Generator().manual_seed(0)
@@ -58,7 +59,7 @@ def main() -> None:
             ref.apparent_radiance(float(th[i, 0]), float(ph[i, 0]), s, m, sea_radiance=30.0, sky=sky)
             t_ref.append(time.perf_counter() - t0)
         ref_rate = 1.0 / statistics.median(t_ref)
-        for dtype in (torch.float32, torch.float64):
+        for dtype in [getattr(torch, d) for d in args.dtypes.split(",")]:
             s = rs.SlopeStatistics.cox_munk(winds.to(dtype), anisotropic=aniso)
             times = []
             for _ in tqdm(range(args.repeats), desc=f"torch {str(dtype)[6:]} ({'aniso' if aniso else 'iso'})", leave=False):
@@ -72,7 +73,7 @@ def main() -> None:
     header = (f"Core benchmark, {args.views} view directions × {args.states} sea states (Cox–Munk 0–30 m/s), "
               f"default accuracy; {platform.processor() or platform.machine()}, {torch.get_num_threads()} threads, "
               f"torch {torch.__version__}, {dt.date.today().isoformat()}.\n"
-              f"Command: `python pipelines/bench_core.py --views {args.views} --states {args.states} --repeats {args.repeats}`\n")
+              f"Command: `python pipelines/bench_core.py --views {args.views} --states {args.states} --repeats {args.repeats} --dtypes {args.dtypes}`\n")
     table = ["| slopes | dtype | torch evals/s | reference evals/s | speed-up | torch wall time (median) |",
              "|---|---|---:|---:|---:|---:|"]
     for slopes, dtype, rate, rrate, ratio, t in rows:

@@ -6,7 +6,8 @@ whole ``render`` (geometry + model + images) against ``torch.nn.functional.grid_
 an output of the same size (the floor of any per-pixel lookup), and against ``method="direct"``
 (timed on a subsampled batch and extrapolated per sea pixel). Then what leaving things out buys
 (sky work, azimuth dimension, table span, gradient bookkeeping), the table's error against direct
-evaluation, and peak memory of a batch of 64 (separate processes, max RSS over the import baseline).
+evaluation, and peak memory of a batch of 64 (separate processes; resident memory sampled every
+millisecond during the render, over the resident memory just before it).
 
 Median of ``--repeats`` runs. Writes a Markdown report to stdout and ``--out``/bench_render.md,
 and bench_render.png.
@@ -61,17 +62,40 @@ def med(fn, repeats: int) -> float:
     return statistics.median(ts)
 
 
+def _rss_mb() -> float:
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    return float("nan")
+
+
 def memory_child(b: int, aniso: bool) -> None:
-    import resource
+    """Peak resident memory of one render of b images over the process's resident memory just
+    before it (after a warm-up render), sampled every millisecond from /proc/self/status."""
+    import threading
 
     cam, sc = batch(b)
     small = rs.make_camera(8, 8, **{k: v[:1] for k, v in cam.items()})
     rs.render(small, rs.SeaScene(**{k: v[:1] for k, v in sc.items()}, anisotropic=aniso, sky=sky))
-    base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     cams = rs.make_camera(H, W, **cam)
-    img = rs.render(cams, rs.SeaScene(**sc, anisotropic=aniso, sky=sky))
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    print(json.dumps({"peak_mb": (peak - base) / 1024, "output_mb": img.numel() * img.element_size() / 2**20}))
+    scene = rs.SeaScene(**sc, anisotropic=aniso, sky=sky)
+    base = _rss_mb()
+    peak = [base]
+    done = threading.Event()
+
+    def poll() -> None:
+        while not done.is_set():
+            peak[0] = max(peak[0], _rss_mb())
+            time.sleep(0.001)
+
+    t = threading.Thread(target=poll)
+    t.start()
+    img = rs.render(cams, scene)
+    done.set()
+    t.join()
+    peak[0] = max(peak[0], _rss_mb())
+    print(json.dumps({"peak_mb": peak[0] - base, "output_mb": img.numel() * img.element_size() / 2**20}))
 
 
 def main() -> None:

@@ -89,7 +89,7 @@ class Quadrature:
     inner: int = 28
     hermite: int = 12
     width: float = 7.5
-    chunk: int = 1 << 20
+    chunk: int = 1 << 18
     split: float = 2.0
 
     def __post_init__(self) -> None:

@@ -13,6 +13,7 @@ from typing import Any
 
 import torch
 from kornia.geometry.camera import PinholeCamera
+from kornia.geometry.conversions import normalize_points_with_intrinsics
 from kornia.geometry.depth import unproject_meshgrid
 
 from ._validation import check_finite_range, per_batch
@@ -221,14 +222,39 @@ class CameraGeometry:
             self.s_h = (torch.sqrt(alt * (2 * Re + alt)) / (Re + alt)).to(dtype)  # sine of the horizon dip
             self.num = (alt * (2 * Re + alt) / (Re + alt)).to(dtype)  # h (2R + h)/(R + h) [m]
 
-    def pixels(self, sl: slice) -> dict[str, torch.Tensor]:
-        """cos θ̂ (sea) / cos of the ray's zenith (sky), the sea mask, and the unit ray's world x, y
-        and local-vertical components, for the cameras ``sl``: each (b, H, W)."""
+    def pixels(self, sl: slice, need_xy: bool = True) -> dict[str, torch.Tensor]:
+        """cos θ̂ (sea) / cos of the ray's zenith (sky), the sea mask, and the unit ray's local-vertical
+        component (and, with ``need_xy``, its world x and y components), for the cameras ``sl``:
+        each (b, H, W).
+
+        Pixel rays come from kornia's unprojection. For a pinhole without skew the normalized ray
+        (x, y, 1) has x depending on the column only and y on the row only, so kornia unprojects one
+        row and one column of pixel centres and each component (a·(x, y, 1))/|(x, y, 1)| is formed
+        by broadcasting: no (b, H, W, 3) tensor. With skew, ``unproject_meshgrid`` does it all.
+        """
         H, W = self.H, self.W
-        rays = unproject_meshgrid(H, W, self.cameras.camera_matrix[sl], normalize_points=True, device=self.device, dtype=self.dtype)
-        b_ = rays.shape[0]
-        d = (rays.reshape(b_, H * W, 3) @ self.axes_cam[sl].transpose(-1, -2)).reshape(b_, H, W, 3)
-        dx, dy, dz = d.unbind(-1)
+        K = self.cameras.camera_matrix[sl].to(self.dtype)
+        A = self.axes_cam[sl]  # (b, 3 components, 3 camera axes)
+        if bool((K[:, 0, 1] == 0).all()):
+            b_ = K.shape[0]
+            u = torch.arange(W, dtype=self.dtype, device=self.device)
+            v = torch.arange(H, dtype=self.dtype, device=self.device)
+            row = torch.stack([u, torch.zeros_like(u)], -1).expand(b_, W, 2)
+            col = torch.stack([torch.zeros_like(v), v], -1).expand(b_, H, 2)
+            x = normalize_points_with_intrinsics(row, K)[..., 0][:, None, :]  # (b, 1, W)
+            y = normalize_points_with_intrinsics(col, K)[..., 1][:, :, None]  # (b, H, 1)
+            inv = torch.rsqrt(x * x + y * y + 1.0)
+
+            def comp(i: int) -> torch.Tensor:
+                a = A[:, i]
+                return ((a[:, 0, None, None] * x + a[:, 2, None, None]) + a[:, 1, None, None] * y) * inv
+        else:
+            rays = unproject_meshgrid(H, W, K, normalize_points=True, device=self.device, dtype=self.dtype)
+
+            def comp(i: int) -> torch.Tensor:
+                return (rays * A[:, i, None, None, :]).sum(-1)
+
+        dz = comp(2)
         if self.flat:
             sea = dz < 0
             cos_t = -dz
@@ -237,7 +263,10 @@ class CameraGeometry:
             sh = self.s_h[sl, None, None]
             sea = -dz > sh
             cos_t = self.k_r[sl, None, None] * torch.sqrt(((-dz - sh) * (-dz + sh)).clamp_min(0.0))  # √(b² − c)/R
-        return {"cos": torch.where(sea, cos_t, dz), "sea": sea, "dx": dx, "dy": dy, "dz": dz}
+        out = {"cos": torch.where(sea, cos_t, dz), "sea": sea, "dz": dz}
+        if need_xy:
+            out["dx"], out["dy"] = comp(0), comp(1)
+        return out
 
     def slant_range(self, cz: torch.Tensor, sea: torch.Tensor, dz: torch.Tensor, sl: slice = slice(None)) -> torch.Tensor:
         """Slant range [m] to the sea (inf for sky pixels) from ``pixels(sl)``'s output."""

@@ -256,20 +256,24 @@ def _masked_range(x: torch.Tensor, mask: torch.Tensor) -> tuple[torch.Tensor, to
     return torch.where(mask, x, inf).amin((1, 2)), torch.where(mask, x, -inf).amax((1, 2))
 
 
-def _azimuth_offsets(phi: torch.Tensor, mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-    """Per-image centre c (B,) and per-pixel offsets wrap_π(φ̂ − c) ∈ [−π/2, π/2) (B, H, W).
+def _azimuth_offsets(
+    dx: torch.Tensor, dy: torch.Tensor, wind_direction: torch.Tensor, mask: torch.Tensor
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Per-image centre c (b,) of the relative azimuths φ̂ = atan2(−dy, −dx) − wind direction of the
+    sea pixels, and per-pixel ``wrap_π(φ̂ − c) + π/2`` ∈ [0, π) (b, H, W).
 
     Period π: the slope density is symmetric under s → −s, so R_a(φ̂ + π) = R_a(φ̂). The centre is
-    the circular mean of 2φ̂ over the sea pixels, halved.
+    the circular mean of 2φ̂ over a subsample of the sea pixels, halved; the per-pixel work is one
+    atan2, one add of a per-image constant and one remainder.
     """
-    step = max(1, int(math.sqrt(phi[0].numel() / 4096)))  # ~4096 pixels suffice for a centre
-    p2 = 2.0 * phi.detach()[:, ::step, ::step]
+    step = max(1, int(math.sqrt(dx[0].numel() / 4096)))  # ~4096 pixels suffice for a centre
+    ps = torch.atan2(-dy[:, ::step, ::step], -dx[:, ::step, ::step]).detach() - wind_direction.detach()[:, None, None]
     m = mask[:, ::step, ::step]
-    m = torch.where(m.flatten(1).any(1)[:, None, None], m, mask[:, ::step, ::step] | True)
-    zero = torch.zeros((), dtype=phi.dtype, device=phi.device)
-    c = 0.5 * torch.atan2(torch.where(m, torch.sin(p2), zero).sum((1, 2)), torch.where(m, torch.cos(p2), zero).sum((1, 2)))
-    o = torch.remainder(phi - c[:, None, None] + math.pi / 2, math.pi) - math.pi / 2
-    return c, o
+    m = m | ~m.flatten(1).any(1)[:, None, None]  # no sea in the subsample: use all of it
+    zero = torch.zeros((), dtype=dx.dtype, device=dx.device)
+    c = 0.5 * torch.atan2(torch.where(m, torch.sin(2 * ps), zero).sum((1, 2)), torch.where(m, torch.cos(2 * ps), zero).sum((1, 2)))
+    k = (math.pi / 2 - c - wind_direction)[:, None, None]
+    return c, torch.remainder(torch.atan2(-dy, -dx) + k, math.pi)
 
 
 def render(
@@ -340,8 +344,10 @@ def render(
             altitude = g.altitude_m
         else:
 
+            iso = bool(((p["vx"] == p["vy"]) & (p["cxy"] == 0)).all())
+
             def source(sl: slice) -> dict[str, torch.Tensor]:
-                out = cg.pixels(sl)
+                out = cg.pixels(sl, need_xy=not iso)
                 if scene.path is not None:
                     out["range"] = cg.slant_range(out["cos"], out["sea"], out["dz"], sl)
                 return out
@@ -421,31 +427,36 @@ def _render_table(
     # ε: a quarter of the smallest rms slope of each image, so ζ resolves the grazing layer.
     lam_min = 0.5 * (p["vx"] + p["vy"] - torch.sqrt((p["vx"] - p["vy"]) ** 2 + 4 * p["cxy"] ** 2))
     eps = (0.25 * torch.sqrt(lam_min.detach().clamp_min(0.0))).clamp(1e-4, 0.05).double()
-    eps_t = eps.to(dtype)
+    inv_eps = (1.0 / eps).to(dtype)
     nz, nphi = table.zenith, (1 if iso else table.azimuth)
     xz, Lz, ez = _lobatto_interp(nz, table.fine_zenith)
     xp, Lp, ep = _lobatto_interp(nphi, 1 if iso else table.fine_azimuth)
     chunks = []
+    out: torch.Tensor | None = None
     zlo, zhi, olo, ohi, centre = [], [], [], [], []
     for i in range(0, B, chunk):
         sl = slice(i, min(i + chunk, B))
         px = source(sl)
         sea = px["sea"]
-        zeta = torch.asinh(px["cos"].clamp_min(0.0) / eps_t[sl, None, None])  # the pixel's own cos θ̂
+        xz_ = px["cos"] * inv_eps[sl, None, None]  # the pixel's own cos θ̂ / ε (sky pixels: masked out)
+        zeta = torch.log(xz_ + torch.sqrt(xz_ * xz_ + 1.0))  # asinh, 3× faster than torch.asinh on CPU
         lo, hi = _masked_range(zeta, sea)
         zlo.append(lo)
         zhi.append(hi)
         entry: dict[str, Any] = {"sl": sl, "sea": sea, "zeta": zeta, "sky": None, "range": px.get("range")}
         if not iso:
-            phi = torch.atan2(-px["dy"], -px["dx"]) - p["wind_direction"][sl, None, None]
-            c, o = _azimuth_offsets(phi, sea)
+            c, o = _azimuth_offsets(px["dx"], px["dy"], p["wind_direction"][sl], sea)  # o ∈ [0, π): offset + π/2
             a, b = _masked_range(o, sea)
             centre.append(c)
             olo.append(a)
             ohi.append(b)
             entry["o"] = o
         if bool((~sea).any()):  # no sky work when no pixel of the chunk sees sky
-            entry["sky"] = _sky_pixels(_slice_sky(p["sky"], sl), px["cos"], sl.stop - sl.start, dtype, device)
+            sky_vals = _sky_pixels(_slice_sky(p["sky"], sl), px["cos"], sl.stop - sl.start, dtype, device)
+            if out is None:
+                out = torch.zeros(B, H, W, dtype=dtype, device=device)
+            out[sl] = sky_vals  # sky pixels land in the output now; sea pixels overwrite in pass 2
+            entry["sky"] = True
         del px
         chunks.append(entry)
     any_sea = torch.cat([torch.isfinite(z) for z in zlo])
@@ -465,11 +476,12 @@ def _render_table(
         a = torch.where(any_sea, torch.cat(olo), torch.zeros(B, dtype=dtype, device=device)).double()
         b = torch.where(any_sea, torch.cat(ohi), torch.ones(B, dtype=dtype, device=device)).double()
         if table.span == "full":
-            a, b = torch.full_like(a, -math.pi / 2), torch.full_like(b, math.pi / 2)
+            a, b = torch.zeros_like(a), torch.full_like(b, math.pi)
         pad = torch.clamp(1e-6 * (b - a), min=1e-6)
         a, b = a - pad, b + pad
         xp_t = torch.as_tensor(xp, dtype=torch.float64, device=device)
-        ph_nodes = (c[:, None] + a[:, None] + (b - a)[:, None] * (xp_t + 1) / 2).to(dtype)
+        # the pixels' o = wrap_π(φ̂ − c) + π/2: nodes at φ̂ = c + o − π/2
+        ph_nodes = (c[:, None] - math.pi / 2 + a[:, None] + (b - a)[:, None] * (xp_t + 1) / 2).to(dtype)
     vz = th_nodes[:, :, None].expand(B, nz, nphi)
     va = ph_nodes[:, None, :].expand(B, nz, nphi)
     slopes = SlopeStatistics.from_variances(p["vx"][:, None, None], p["vy"][:, None, None], p["cxy"][:, None, None])
@@ -479,28 +491,36 @@ def _render_table(
     coarse = rb - rb * t_rho + t_s  # R_a at the nodes (B, nz, nphi); linear in the node values
     Lz_t = torch.as_tensor(Lz, dtype=dtype, device=device)
     Lp_t = torch.as_tensor(Lp, dtype=dtype, device=device)
-    fine = torch.einsum("iz,bzp,jp->bij", Lz_t, coarse, Lp_t)[:, None]  # (B, 1, Mz, Mp)
+    # the fine table (Mz × Mp per image) is made per chunk in pass 2, not for the whole batch
     lo_t, span_z = lo.to(dtype), (hi - lo).to(dtype)
     if not iso:
         a_t, span_p = a.to(dtype), (b - a).to(dtype)
-    out = []
     while chunks:
         e = chunks.pop(0)
         sl = e["sl"]
-        gy = (2.0 * (e["zeta"] - lo_t[sl, None, None]) / span_z[sl, None, None] - 1.0) / (1.0 + ez)
+        zs = (2.0 / (span_z * (1.0 + ez)))[sl, None, None]
+        gy = torch.addcmul(((-2.0 * lo_t / span_z - 1.0) / (1.0 + ez))[sl, None, None], e["zeta"], zs)
         if iso:
             gx = torch.zeros_like(gy)
         else:
-            gx = (2.0 * (e["o"] - a_t[sl, None, None]) / span_p[sl, None, None] - 1.0) / (1.0 + ep)
+            scale = (2.0 / (span_p * (1.0 + ep)))[sl, None, None]
+            shift = ((-2.0 * a_t / span_p - 1.0) / (1.0 + ep))[sl, None, None]
+            gx = torch.addcmul(shift, e["o"], scale)
         # bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges
         # only to first order; bilinear on the fine table is second order (~1e-7 at 4096 rows).
-        vals = F.grid_sample(fine[sl], torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border", align_corners=True)[:, 0]
+        fine = torch.einsum("iz,bzp,jp->bij", Lz_t, coarse[sl], Lp_t)[:, None]  # (b, 1, Mz, Mp)
+        vals = F.grid_sample(fine, torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border", align_corners=True)[:, 0]
+        del fine, gx, gy
         if scene.path is not None:
             vals = _apply_path(scene.path, vals, altitude[sl], e["range"], e["sea"])
         if e["sky"] is not None:
-            vals = torch.where(e["sea"], vals, e["sky"])
-        out.append(vals)
-    return torch.cat(out) if len(out) > 1 else out[0]
+            vals = torch.where(e["sea"], vals, out[sl])
+        if out is None:
+            if sl.stop - sl.start == B:
+                return vals
+            out = torch.empty(B, H, W, dtype=vals.dtype, device=device)
+        out[sl] = vals  # chunks land in place (autograd records the slice copies)
+    return out
 
 
 class SeaRenderer(torch.nn.Module):
