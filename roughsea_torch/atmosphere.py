@@ -17,8 +17,16 @@ What is tabulated (SI units):
   (2.894–14.286 µm; LOWTRAN's resolution is 20 cm⁻¹);
 - path: spectral transmittance and path radiance of the air between a sensor at altitude h
   (2 m – 5 km) and the sea point at slant range r (from h straight down to the geometric horizon
-  √(2hR + h²), R = 6371 km), in 20 cm⁻¹ bins; path radiance excludes the sea's own emission;
+  √(2hR + h²), R = 6371 km), on the same 5 cm⁻¹ grid (stored as rank-K SVD factors, accurate to
+  1e-3 in τ and 2e-3 of the surface blackbody in path radiance per sample, ~10× better in band
+  integrals); the path radiance excludes the sea's own emission;
 - the model's surface air temperature and temperature/pressure profile.
+
+Sources of error, all measured by the generator and recorded in :func:`provenance`: LOWTRAN7 itself
+(a band model, typically a few % against line-by-line codes), the interpolation of the tables
+(held-out error ≤ 1e-3; see the functions), the path compression (above). How LOWTRAN was driven for
+the paths (range-matched refracted slant paths above 200 m, horizontal paths at the line of sight's
+mean height below, where LOWTRAN's float32 geometry fails) is explained in the generator's docstring.
 
 Band integration: ``∫ y(λ) r(λ) dλ`` over the band, y interpolated linearly in wavelength between
 the tabulated samples, r the relative response (``None`` = 1; a callable of wavelength [m]; or a
@@ -32,7 +40,7 @@ Example:
     >>> import torch, roughsea_torch.atmosphere as atm
     >>> sky = atm.load_sky("midlatitude_summer", band=(8e-6, 12e-6))
     >>> round(float(sky(torch.tensor(1.0))), 1)   # zenith, W m-2 sr-1
-    11.0
+    11.1
     >>> path = atm.load_path("midlatitude_summer", band=(8e-6, 12e-6))
     >>> tau, lp = path(torch.tensor(20.0), torch.tensor(5000.0))   # sensor at 20 m, sea 5 km away
     >>> 0.0 < float(tau) < 1.0 and float(lp) > 0.0
@@ -66,6 +74,8 @@ __all__ = [
     "load_spectral",
     "provenance",
     "horizon_range",
+    "spectral_weights",
+    "transmittance_weights",
 ]
 
 ATMOSPHERES = (
@@ -79,9 +89,6 @@ ATMOSPHERES = (
 EARTH_RADIUS_M = 6_371_000.0  # the Earth radius of the path tables (physics.md §8)
 DATA_DIR = Path(__file__).resolve().parent / "data" / "lowtran"
 _TAU_FLOOR = 1e-9  # band transmittances below this (opaque bands, long paths) are held at it
-
-# Interpolation of the path tables (chosen by the held-out errors printed by the generator).
-_PATH_MODE = "bilinear"
 
 
 # --------------------------------------------------------------------------------------------------
@@ -102,10 +109,8 @@ def available_atmospheres(data_dir: str | Path | None = None) -> list[str]:
 def _check_name(name: Any, data_dir: str | Path | None) -> str:
     avail = available_atmospheres(data_dir)
     if not isinstance(name, str) or name not in avail:
-        raise ValueError(
-            f"name: unknown atmosphere {name!r}; available: {', '.join(avail) or '(none: no tables in '}"
-            + ("" if avail else f"{_dir(data_dir)})")
-        )
+        listing = ", ".join(avail) if avail else f"none (no tables in {_dir(data_dir)})"
+        raise ValueError(f"name: unknown atmosphere {name!r}; available: {listing}")
     return name
 
 
@@ -367,7 +372,7 @@ class AtmosphericPath:
         self._lev, self._g0, self._g1 = lev, g0, g1
         c0 = np.log(-np.log(tau))
         c1 = np.log(radiance / (-np.expm1(np.log(tau))))
-        self._table = np.stack([c0, c1])[None]  # (1, 2, Nh, Nu)
+        self._table = np.stack([c0, c1])[:, None]  # (2, 1, Nh, Nu): the two quantities as a batch
         self.dtype = dtype
         self.device = torch.device(device) if device is not None else torch.device("cpu")
         self._cache: dict[tuple[torch.dtype, torch.device], tuple[torch.Tensor, ...]] = {}
@@ -378,7 +383,7 @@ class AtmosphericPath:
         if key not in self._cache:
             f = lambda a: torch.as_tensor(a, dtype=dtype, device=device)  # noqa: E731
             has_lev = ~np.isnan(self._lev)
-            self._cache[key] = (f(self._table), torch.as_tensor(self._h, dtype=torch.float64, device=device),
+            self._cache[key] = (f(self._table), f(self._h),
                                 f(np.nan_to_num(self._lev)), torch.as_tensor(has_lev, device=device),
                                 f(self._g0), f(self._g1), f(np.log(self._h[:-1])), f(np.log(self._h[1:])))
         return self._cache[key]
@@ -387,19 +392,17 @@ class AtmosphericPath:
         """√(2 h R + h²) [m]: the longest range at which a line of sight from h meets the sea."""
         return horizon_range(altitude_m)
 
-    def _altitude_index(self, h: torch.Tensor, dtype: torch.dtype, device: torch.device,
-                        levels: bool) -> torch.Tensor:
-        """Fractional node index of altitudes h, piecewise linear in log h, or (``levels``) in
+    def _altitude_indices(self, h: torch.Tensor, dtype: torch.dtype, device: torch.device,
+                          log_h: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """Fractional node indices of altitudes h: piecewise linear in log h, and (second) in
         log(h − L + c) in the cells above a LOWTRAN level L. Differentiable in h."""
         _, nodes, lev, has_lev, g0, g1, l0, l1 = self._tensors(dtype, device)
-        i = torch.searchsorted(nodes, h.detach().double().contiguous(), right=True).clamp(1, nodes.numel() - 1) - 1
-        if levels:
-            hl = has_lev[i]
-            g = torch.where(hl, torch.log((h - lev[i]).clamp_min(0.0) + self._offset), torch.log(h))
-            t = (g - g0[i]) / (g1[i] - g0[i])
-        else:
-            t = (torch.log(h) - l0[i]) / (l1[i] - l0[i])
-        return i.to(dtype) + t
+        i = torch.searchsorted(nodes, h.detach().contiguous(), right=True).clamp(1, nodes.numel() - 1) - 1
+        fi = i.to(dtype)
+        x0 = fi + (log_h - l0[i]) / (l1[i] - l0[i])
+        g = torch.where(has_lev[i], torch.log((h - lev[i]).clamp_min(0.0) + self._offset), log_h)
+        x1 = fi + (g - g0[i]) / (g1[i] - g0[i])
+        return x0, x1
 
     def __call__(self, altitude_m: Any, range_m: Any, *, clamp: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
         tensors = [x for x in (altitude_m, range_m) if isinstance(x, torch.Tensor)]
@@ -416,39 +419,42 @@ class AtmosphericPath:
         h = torch.as_tensor(altitude_m, dtype=dtype, device=device)
         r = torch.as_tensor(range_m, dtype=dtype, device=device)
         h, r = torch.broadcast_tensors(h, r)
+        shape = h.shape
+        h, r = h.reshape(-1), r.reshape(-1)
         lo, hi = self.altitude_range_m
+        slack = 1e-6 if dtype == torch.float64 else 1e-5
         if not clamp:
-            hd, rd = h.detach().double(), r.detach().double()
-            bad_h = torch.isnan(hd) | (hd < lo * (1 - 1e-6)) | (hd > hi * (1 + 1e-6))
-            if bad_h.any():
+            hd, rd = h.detach(), r.detach()
+            ok_h = (hd >= lo * (1 - slack)) & (hd <= hi * (1 + slack))  # False for NaN
+            if not bool(ok_h.all()):
                 raise ValueError(f"altitude_m must lie in [{lo:g}, {hi:g}] m (the path tables); "
-                                 f"got {hd[bad_h].flatten()[0].item()!r}")
-            r_hor = horizon_range(hd)
-            bad_r = torch.isnan(rd) | (rd < hd * (1 - 1e-6)) | (rd > r_hor * (1 + 1e-6))
-            if bad_r.any():
-                k = torch.nonzero(bad_r.flatten())[0, 0]
-                hb, rb = hd.flatten()[k].item(), rd.flatten()[k].item()
+                                 f"got {hd[~ok_h][0].item()!r}")
+            ok_r = (rd >= hd * (1 - slack)) & (rd <= horizon_range(hd) * (1 + slack))
+            if not bool(ok_r.all()):
+                k = torch.nonzero(~ok_r)[0, 0]
+                hb, rb = hd[k].item(), rd[k].item()
                 raise ValueError(
                     f"range_m must lie in [altitude_m, sqrt(2 h R + h^2)] = [{hb:g}, "
                     f"{math.sqrt(hb * (2 * EARTH_RADIUS_M + hb)):g}] m for altitude_m = {hb:g} "
                     f"(a longer line of sight passes above the horizon); got {rb!r}"
                 )
         h = h.clamp(lo, hi)  # clamp=False: rounding only
-        r = torch.minimum(torch.maximum(r, h), horizon_range(h))
-        shape = h.shape
+        r_hor = horizon_range(h)
+        r = torch.minimum(torch.maximum(r, h), r_hor)
         if h.numel() == 0:
             return torch.empty(shape, dtype=dtype, device=device), torch.empty(shape, dtype=dtype, device=device)
         table = self._tensors(dtype, device)[0]
         n_h = table.shape[-2]
+        log_h = torch.log(h)
         # u = log(r/h) / log(r_hor/h); at the 2 m - 5 km of the tables log(r_hor/h) >= 3.9
-        u = torch.log(r / h) / torch.log(horizon_range(h) / h)
-        gx = u.reshape(-1) * 2.0 - 1.0
-        out = []
-        for c, levels in ((0, False), (1, True)):  # log optical depth; log source radiance
-            gy = self._altitude_index(h.reshape(-1), dtype, device, levels) * (2.0 / (n_h - 1)) - 1.0
-            grid = torch.stack([gx, gy], dim=-1).reshape(1, 1, -1, 2)
-            out.append(F.grid_sample(table[:, c:c + 1], grid, mode="bilinear", padding_mode="border",
-                                     align_corners=True).reshape(-1))
+        gx = (torch.log(r) - log_h) / (torch.log(r_hor) - log_h) * 2.0 - 1.0
+        x0, x1 = self._altitude_indices(h, dtype, device, log_h)
+        scale = 2.0 / (n_h - 1)
+        # one grid_sample, the two quantities as a batch of 2, each with its own altitude coordinate:
+        # log optical depth (log h) and log source radiance (the level coordinate)
+        grid = torch.stack([torch.stack([gx, x0 * scale - 1.0], -1), torch.stack([gx, x1 * scale - 1.0], -1)])
+        out = F.grid_sample(table, grid.unsqueeze(1), mode="bilinear", padding_mode="border",
+                            align_corners=True)[:, 0, 0, :]
         depth = torch.exp(out[0])
         tau = torch.exp(-depth).reshape(shape)
         rad = (torch.exp(out[1]) * -torch.expm1(-depth)).reshape(shape)
