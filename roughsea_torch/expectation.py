@@ -45,7 +45,7 @@ from typing import Any, Callable
 import numpy as np
 import torch
 
-from ._validation import as_tensor, check_finite_range, resolve_dtype_device
+from ._validation import as_tensor, check_finite_range, check_same_device, resolve_dtype_device
 from .optics import _fresnel_terms, split_refractive_index
 from .sky import ConstantSky, TabulatedSky, as_sky
 from .slopes import SlopeStatistics
@@ -548,10 +548,9 @@ def reflection_terms(
     sky_fn = as_sky(sky)
     sky_tensor = sky_fn.radiance if isinstance(sky_fn, (TabulatedSky, ConstantSky)) else None
     extra = {k: v for k, v in (_extra or {}).items() if isinstance(v, torch.Tensor)}
-    dtype, device, vz, va, vx, vy, cxy = _prepare(
-        view_zenith, view_azimuth, slopes, refractive_index,
-        sky=sky_tensor if isinstance(sky_tensor, torch.Tensor) else None, **extra,
-    )
+    dtype, device, vz, va, vx, vy, cxy = _prepare(view_zenith, view_azimuth, slopes, refractive_index, **extra)
+    if isinstance(sky_tensor, torch.Tensor):  # a sky table follows the call's dtype; only its device must match
+        check_same_device(view_zenith=vz, sky=sky_tensor)
     n, k = split_refractive_index(refractive_index, dtype, device)
     q = quadrature or Quadrature.default(dtype)
     shape = torch.broadcast_shapes(

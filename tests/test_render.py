@@ -233,3 +233,20 @@ def test_scene_path_arguments():
     with pytest.raises(ValueError, match="path must be"):
         rs.SeaScene(wind_speed=3.0, sea_temperature=290.0, sky=1.0, path=3.0)
     assert rs.SeaScene(wind_speed=3.0, sea_temperature=290.0, sky=1.0).path is None  # no model for a custom sky
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+def test_default_scene_with_named_atmosphere_and_path(dtype):
+    """The README's default scene: shipped LOWTRAN sky (float64 tables) in a float32 or float64 render,
+    path on; table matches direct; the image keeps the cameras' dtype."""
+    cams = rs.make_camera(24, 32, hfov_deg=30.0, altitude_m=torch.tensor([20.0, 300.0]),
+                          pitch_deg=torch.tensor([-2.0, -6.0]), dtype=dtype)
+    scene = rs.SeaScene(wind_speed=torch.tensor([4.0, 12.0]), wind_direction=0.3, sea_temperature=290.0)
+    assert scene.path is not None
+    geom = rs.view_geometry(cams)
+    table = rs.render(cams, scene, geometry=geom, output="brightness_temperature")
+    direct = rs.render(cams, scene, geometry=geom, method="direct", output="brightness_temperature")
+    assert table.dtype == dtype
+    torch.testing.assert_close(table, direct, rtol=0, atol=2e-3)  # 2 mK
+    mst = rs.SeaScene(wind_speed=5.0, sea_temperature=290.0, band=rs.MWIR)
+    assert 0.5 < float(mst.sky(torch.tensor(1.0))) < 1.2  # the MWIR sky, not the LWIR one
