@@ -158,7 +158,6 @@ class ConstantSky:
         return f"ConstantSky({self.radiance!r})"
 
 
-SkyLike = Callable[[torch.Tensor], torch.Tensor] | TabulatedSky | ConstantSky | float | tuple
 
 
 def as_sky(sky: Any) -> Callable[[torch.Tensor], torch.Tensor]:

@@ -11,7 +11,7 @@ import torch
 import roughsea_torch as rs
 from roughsea_torch.expectation import Quadrature
 
-from conftest import DEG, smooth_sky
+from conftest import DEG
 
 M = 1.218 + 0.0508j
 SMALL = Quadrature(outer=8, inner=8, hermite=6, width=9.0)  # gradcheck differentiates the rule itself;
