@@ -38,6 +38,28 @@ def test_second_law_sky_equal_sea_gives_sea_radiance(backend, shadowing):
             np.testing.assert_allclose(ra, 27.5, rtol=max(backend.rtol, 1e-7) * 0.1)
 
 
+@pytest.mark.parametrize("theta_deg", [0.0, 30.0])
+def test_apparent_radiance_links_to_emissivity_when_every_facet_sees_sky(backend, theta_deg):
+    """Where the sky disc covers the whole slope distribution (near nadir, moderate roughness),
+    Eq. 10 with a constant sky c ≠ R_B is R_a = ε̄ R_B + (1 − ε̄) c, with ε̄ from ``emissivity``: two
+    independent integrals (visible half-plane vs sky disc) must agree. Not true by construction."""
+    th = theta_deg * DEG
+    slopes = backend.cox_munk(5.0, anisotropic=True)
+    eps = backend.emissivity(th, 0.4, slopes, M11)
+    ra = backend.apparent_radiance(th, 0.4, slopes, M11, 30.0, 12.0)
+    np.testing.assert_allclose(ra, eps * 30.0 + (1.0 - eps) * 12.0, rtol=max(backend.rtol, 1e-7))
+
+
+def test_view_azimuth_conventions(backend):
+    """r = 0: the slope density is mirror-symmetric about the upwind axis, so R(φ̂) = R(−φ̂); and
+    anisotropic slopes make upwind and crosswind views differ."""
+    slopes = backend.cox_munk(15.0, anisotropic=True)
+    th = 85 * DEG
+    r = [backend.apparent_radiance(th, ph, slopes, M11, 30.0, smooth_sky) for ph in (0.5, -0.5, 0.0, math.pi / 2)]
+    np.testing.assert_allclose(r[0], r[1], rtol=max(backend.rtol, 1e-7))
+    assert abs(r[2] - r[3]) > 1e-3 * r[2]
+
+
 def test_no_shadowing_denominator_is_cos_view_zenith(backend):
     """Eq. 7: without shadowing the Eq. 5 denominator integrates to cos θ̂."""
     for slopes in (backend.cox_munk(20.0), backend.slopes(0.25, 0.06, -0.7)):

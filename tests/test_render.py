@@ -65,11 +65,26 @@ def test_horizon_depression_and_distance_on_a_sphere():
     first = int(torch.nonzero(col)[0])
     f = float(cams.fx[0])
     elev = lambda row: -dip + math.degrees(math.atan(((H - 1) / 2 - row) / f))  # noqa: E731
-    assert elev(first) <= -dip < elev(first - 1)  # the sea starts at the depressed horizon
-    assert abs(dip - 0.1436) < 5e-4
+    row_deg = math.degrees(math.atan(1 / f))  # one row [deg]
+    # the sea starts at the depressed horizon, 0.1436° below the horizontal (physics.md §8)
+    assert elev(first) <= -0.1436 + row_deg and elev(first - 1) > -0.1436 - row_deg
     far = float(geom.range_m[0, first, 1])
     assert abs(far - math.sqrt(2 * h * R)) / math.sqrt(2 * h * R) < 0.02
     assert float(geom.view_zenith[0, first, 1]) > 89.9 * DEG  # LOS tangent at the horizon
+
+
+def test_rotating_wind_and_camera_together_leaves_the_image_unchanged():
+    """Azimuth conventions end to end: the scene is symmetric under a rotation about the vertical, so
+    yaw + δ with wind direction + δ gives the same image (anisotropic slopes, table method)."""
+    def img(yaw_deg, wind_dir):
+        cams = rs.make_camera(24, 32, hfov_deg=30.0, altitude_m=30.0, pitch_deg=-4.0, yaw_deg=yaw_deg, dtype=torch.float64)
+        return rs.render(cams, rs.SeaScene(wind_speed=15.0, wind_direction=wind_dir, sea_temperature=290.0, sky=sky))
+
+    a = img(0.0, 0.3)
+    b = img(40.0, 0.3 + math.radians(40.0))
+    c = img(40.0, 0.3)  # camera turned, wind not: a different view of the anisotropic sea
+    torch.testing.assert_close(a, b, rtol=2e-6, atol=0)
+    assert (a - c).abs().max() > 1e-3
 
 
 def test_flat_sea_geometry_is_the_plane():

