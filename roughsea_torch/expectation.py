@@ -47,7 +47,7 @@ import torch
 
 from ._validation import as_tensor, check_finite_range, check_same_device, resolve_dtype_device
 from .optics import _fresnel_terms, split_refractive_index
-from .sky import ConstantSky, TabulatedSky, as_sky
+from .sky import ConstantSky, TabulatedSky, as_sky, select_sky
 from .slopes import SlopeStatistics
 
 __all__ = [
@@ -366,12 +366,11 @@ def _sky_batch_shape(sky: Any) -> tuple[int, ...]:
 def _sky_chunk(sky: Any, shape: torch.Size, sl: torch.Tensor | slice, device: torch.device) -> Callable:
     """The sky restricted to the flat batch elements ``sl`` (batched tables/constants only)."""
     if isinstance(sky, TabulatedSky) and sky.radiance.ndim > 1:
-        r = sky.radiance.to(device).expand(*shape, sky.radiance.shape[-1]).reshape(-1, sky.radiance.shape[-1])
-        return sky.with_radiance(r[sl])
-    if isinstance(sky, ConstantSky) and torch.as_tensor(sky.radiance).ndim > 0:
-        r = torch.as_tensor(sky.radiance, device=device).expand(shape).reshape(-1)
-        return ConstantSky(r[sl])
-    return sky
+        nz = sky.radiance.shape[-1]
+        sky = sky.with_radiance(sky.radiance.to(device).expand(*shape, nz).reshape(-1, nz))
+    elif isinstance(sky, ConstantSky) and torch.as_tensor(sky.radiance).ndim > 0:
+        sky = ConstantSky(torch.as_tensor(sky.radiance, device=device).expand(shape).reshape(-1))
+    return select_sky(sky, sl)
 
 
 def _run_chunked(

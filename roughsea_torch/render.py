@@ -37,7 +37,7 @@ from .expectation import Quadrature, apparent_radiance, reflection_terms
 from .geometry import EARTH_RADIUS_M, CameraGeometry, ViewGeometry, view_geometry
 from .optics import band_refractive_index, split_refractive_index
 from .radiometry import LWIR, SpectralBand, as_band, band_radiance, brightness_temperature
-from .sky import ConstantSky, TabulatedSky, as_sky
+from .sky import ConstantSky, TabulatedSky, as_sky, select_sky
 from .slopes import SlopeStatistics
 
 __all__ = ["SeaScene", "render", "SeaRenderer", "TableSize"]
@@ -133,6 +133,7 @@ class SeaScene:
             raise ValueError(f"path must be None, a bool, an atmosphere name or an AtmosphericPath; got {path!r}")
         self.path = path or None
         self.refractive_index = refractive_index
+        self._band_index: torch.Tensor | None = None  # the band-effective water index, made on first use
         self.shadowing = shadowing
 
     @property
@@ -158,14 +159,16 @@ class SeaScene:
         wd = per_batch("wind_direction", self.wind_direction, B, dtype, device)
         if self.sea_radiance is not None:
             rb = per_batch("sea_radiance", self.sea_radiance, B, dtype, device)
-            t_ref: Any = 300.0
         else:
             t_sea = per_batch("sea_temperature", self.sea_temperature, B, dtype, device)
             rb = band_radiance(t_sea, self.band)
-            t_ref = t_sea.detach()
         m = self.refractive_index
-        if m is None:
-            m = band_refractive_index(self.band, t_ref)
+        if m is None:  # per scene, not per render: the fit depends only on the band and T_sea
+            if self._band_index is None:
+                t_own = self.sea_temperature if self.sea_temperature is not None else 300.0
+                t_own = t_own.detach().double().cpu() if isinstance(t_own, torch.Tensor) else float(t_own)
+                self._band_index = band_refractive_index(self.band, t_own)
+            m = self._band_index
         n, k = split_refractive_index(m, dtype, device)
         return dict(vx=vx, vy=vy, cxy=cxy, wind_direction=wd, rb=rb, n=n.expand(B), k=k.expand(B), sky=self.sky)
 
@@ -370,11 +373,7 @@ def _sea_direct(geom: ViewGeometry, p: dict[str, Any], scene: SeaScene, q: Quadr
     th = geom.view_zenith[sea]
     ph = _relative_azimuth(geom, p)[sea]
     slopes = SlopeStatistics.from_variances(p["vx"][img_idx], p["vy"][img_idx], p["cxy"][img_idx])
-    sky = p["sky"]
-    if isinstance(sky, TabulatedSky) and sky.radiance.ndim > 1:
-        sky = sky.with_radiance(sky.radiance.to(th.device, th.dtype)[img_idx])
-    elif isinstance(sky, ConstantSky) and torch.as_tensor(sky.radiance).ndim > 0:
-        sky = ConstantSky(torch.as_tensor(sky.radiance, dtype=th.dtype, device=th.device)[img_idx])
+    sky = select_sky(p["sky"], img_idx.cpu())
     vals = apparent_radiance(
         th, ph, slopes, (p["n"][img_idx], p["k"][img_idx]), sea_radiance=p["rb"][img_idx], sky=sky,
         shadowing=scene.shadowing, quadrature=q,
@@ -396,14 +395,6 @@ def _apply_path(path: Any, radiance: torch.Tensor, altitude: torch.Tensor, range
     r = torch.where(sea, range_m.to(radiance.dtype), h)  # any valid range off the sea
     tau, lp = path(h, r, clamp=True)
     return torch.where(sea, tau * radiance + lp, radiance)
-
-
-def _slice_sky(sky: Any, sl: slice) -> Any:
-    if isinstance(sky, TabulatedSky) and sky.radiance.ndim > 1:
-        return sky.with_radiance(sky.radiance[sl])
-    if isinstance(sky, ConstantSky) and torch.as_tensor(sky.radiance).ndim > 0:
-        return ConstantSky(torch.as_tensor(sky.radiance)[sl])
-    return sky
 
 
 def _render_table(
@@ -452,7 +443,7 @@ def _render_table(
             ohi.append(b)
             entry["o"] = o
         if bool((~sea).any()):  # no sky work when no pixel of the chunk sees sky
-            sky_vals = _sky_pixels(_slice_sky(p["sky"], sl), px["cos"], sl.stop - sl.start, dtype, device)
+            sky_vals = _sky_pixels(select_sky(p["sky"], sl), px["cos"], sl.stop - sl.start, dtype, device)
             if out is None:
                 out = torch.zeros(B, H, W, dtype=dtype, device=device)
             out[sl] = sky_vals  # sky pixels land in the output now; sea pixels overwrite in pass 2

@@ -17,7 +17,7 @@ from typing import Any, Callable
 import numpy as np
 import torch
 
-__all__ = ["TabulatedSky", "ConstantSky", "as_sky", "pchip_derivatives"]
+__all__ = ["TabulatedSky", "ConstantSky", "as_sky", "select_sky", "pchip_derivatives"]
 
 
 def pchip_derivatives(x: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
@@ -158,6 +158,16 @@ class ConstantSky:
         return f"ConstantSky({self.radiance!r})"
 
 
+
+
+def select_sky(sky: Any, index: Any) -> Any:
+    """The sky of some sea states: rows ``index`` of a batched table or constant whose leading dim
+    runs over the (flattened) batch; a shared sky is returned as it is."""
+    if isinstance(sky, TabulatedSky) and sky.radiance.ndim > 1:
+        return sky.with_radiance(sky.radiance[index])
+    if isinstance(sky, ConstantSky) and torch.as_tensor(sky.radiance).ndim > 0:
+        return ConstantSky(torch.as_tensor(sky.radiance)[index])
+    return sky
 
 
 def as_sky(sky: Any) -> Callable[[torch.Tensor], torch.Tensor]:
