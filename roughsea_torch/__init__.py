@@ -37,6 +37,8 @@ from .geometry import EARTH_RADIUS_M, ViewGeometry, make_camera, view_geometry
 from .render import SeaRenderer, SeaScene, TableSize, render
 from .sensitivity import pixel_derivative
 from .slopes import SlopeStatistics, slope_pdf
+from . import atmosphere, augmentation  # noqa: E402  (submodules as attributes: rs.atmosphere, ...)
+from .augmentation import RandomSeaBackground, SceneSampler
 
 __version__ = "0.1.0"
 
@@ -50,6 +52,8 @@ __all__ = [
     "TableSize",
     "ViewGeometry",
     "Quadrature",
+    "RandomSeaBackground",
+    "SceneSampler",
     "SlopeStatistics",
     "SpectralBand",
     "TabulatedSky",

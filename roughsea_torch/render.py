@@ -69,6 +69,13 @@ class SeaScene:
             the 16 km horizon, shifting a 290 K sea by +0.2 K, +1.1 K, +4.0 K (more than a typical
             NETD of 0.05 K beyond ~20 m). Sky pixels see the sky table along their own ray (from
             sea level: for a high sensor the sky above it is somewhat colder; not modelled).
+        air_temperature: T_air [K] of the surface air, float or (B,); only with a named atmosphere
+            (default ``None``: the atmosphere's own, e.g. 294.2 K for midlatitude summer). The
+            atmosphere's temperature profile is taken as shifted so that its surface air is at
+            T_air; sky and path radiance are scaled by B(T_air) / B(T_atm) (band radiances). That
+            is exact where the air is optically thick (the horizon sky, long paths: radiance
+            → B(T_air)) and first-order right for thin emission from near-surface air (the LWIR
+            window's water vapour); it does not change the transmittance.
 
     Example:
         >>> scene = SeaScene(wind_speed=torch.tensor([3.0, 12.0]), wind_direction=0.5,
@@ -92,6 +99,7 @@ class SeaScene:
         refractive_index: Any = None,
         shadowing: bool = True,
         path: Any = None,
+        air_temperature: Any = None,
     ):
         if (slopes is None) == (wind_speed is None):
             raise ValueError("SeaScene: give exactly one of slopes= or wind_speed=")
@@ -132,6 +140,14 @@ class SeaScene:
         if path is not False and not callable(path):
             raise ValueError(f"path must be None, a bool, an atmosphere name or an AtmosphericPath; got {path!r}")
         self.path = path or None
+        if air_temperature is not None:
+            if self.atmosphere is None:
+                raise ValueError("air_temperature needs a named atmosphere (sky='<name>'); scale a custom sky yourself")
+            check_finite_range("air_temperature", air_temperature, 200.0, 350.0, unit="K")
+            from .atmosphere import surface_air_temperature
+
+            self._atmosphere_air_temperature = surface_air_temperature(self.atmosphere)
+        self.air_temperature = air_temperature
         self.refractive_index = refractive_index
         self._band_index: torch.Tensor | None = None  # the band-effective water index, made on first use
         self.shadowing = shadowing
@@ -142,7 +158,7 @@ class SeaScene:
             int(v.shape[0])
             for v in (
                 self.slopes.var_upwind, self.slopes.var_crosswind, self.slopes.cov, self.wind_direction,
-                self.sea_temperature, self.sea_radiance,
+                self.sea_temperature, self.sea_radiance, self.air_temperature,
             )
             if isinstance(v, torch.Tensor) and v.ndim > 0
         }
@@ -170,7 +186,14 @@ class SeaScene:
                 self._band_index = band_refractive_index(self.band, t_own)
             m = self._band_index
         n, k = split_refractive_index(m, dtype, device)
-        return dict(vx=vx, vy=vy, cxy=cxy, wind_direction=wd, rb=rb, n=n.expand(B), k=k.expand(B), sky=self.sky)
+        sky, air_scale = self.sky, None
+        if self.air_temperature is not None:  # B(T_air) / B(T_atm): scales sky and path radiance
+            t_air = per_batch("air_temperature", self.air_temperature, B, dtype, device)
+            t_atm = torch.tensor(self._atmosphere_air_temperature, dtype=dtype, device=device)
+            air_scale = band_radiance(t_air, self.band) / band_radiance(t_atm, self.band)
+            sky = sky.with_radiance(sky.radiance.to(dtype=dtype, device=device) * air_scale[:, None])
+        return dict(vx=vx, vy=vy, cxy=cxy, wind_direction=wd, rb=rb, n=n.expand(B), k=k.expand(B), sky=sky,
+                    air_scale=air_scale)
 
 
 @dataclass(frozen=True)
@@ -329,7 +352,7 @@ def render(
         if bool(sea.any()):
             img = _sea_direct(geom, p, scene, q)
             if scene.path is not None:
-                img = _apply_path(scene.path, img, geom.altitude_m, geom.range_m, sea)
+                img = _apply_path(scene.path, img, geom.altitude_m, geom.range_m, sea, p["air_scale"])
         if bool((~sea).any()):
             sky_pix = _sky_pixels(p["sky"], geom.cos_view_zenith, B, dtype, device)
             img = sky_pix if img is None else torch.where(sea, img, sky_pix)
@@ -389,11 +412,15 @@ def _sky_pixels(sky: Any, cos_z: torch.Tensor, B: int, dtype: torch.dtype, devic
     return _sky_radiance_pixels(_sky_per_image(sky, b, dtype, device, 0), cos_z.reshape(b, -1)).reshape(b, H, W)
 
 
-def _apply_path(path: Any, radiance: torch.Tensor, altitude: torch.Tensor, range_m: torch.Tensor, sea: torch.Tensor) -> torch.Tensor:
-    """τ · R_a + L_path at each sea pixel (other pixels unchanged); (b, H, W)."""
+def _apply_path(path: Any, radiance: torch.Tensor, altitude: torch.Tensor, range_m: torch.Tensor, sea: torch.Tensor,
+                air_scale: torch.Tensor | None = None) -> torch.Tensor:
+    """τ · R_a + L_path at each sea pixel (other pixels unchanged); (b, H, W). ``air_scale`` (b,)
+    scales L_path (SeaScene's air_temperature)."""
     h = altitude.to(radiance.dtype)[:, None, None].expand_as(radiance)
     r = torch.where(sea, range_m.to(radiance.dtype), h)  # any valid range off the sea
     tau, lp = path(h, r, clamp=True)
+    if air_scale is not None:
+        lp = lp * air_scale[:, None, None]
     return torch.where(sea, tau * radiance + lp, radiance)
 
 
@@ -503,7 +530,8 @@ def _render_table(
         vals = F.grid_sample(fine, torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border", align_corners=True)[:, 0]
         del fine, gx, gy
         if scene.path is not None:
-            vals = _apply_path(scene.path, vals, altitude[sl], e["range"], e["sea"])
+            vals = _apply_path(scene.path, vals, altitude[sl], e["range"], e["sea"],
+                               None if p["air_scale"] is None else p["air_scale"][sl])
         if e["sky"] is not None:
             vals = torch.where(e["sea"], vals, out[sl])
         if out is None:

@@ -265,3 +265,27 @@ def test_default_scene_with_named_atmosphere_and_path(dtype):
     torch.testing.assert_close(table, direct, rtol=0, atol=2e-3)  # 2 mK
     mst = rs.SeaScene(wind_speed=5.0, sea_temperature=290.0, band=rs.MWIR)
     assert 0.5 < float(mst.sky(torch.tensor(1.0))) < 1.2  # the MWIR sky, not the LWIR one
+
+
+def test_air_temperature_shifts_sky_and_path():
+    """SeaScene(air_temperature=): the atmosphere's own value changes nothing; warmer air makes
+    the optically thick horizon sky warmer by about the same number of kelvin, and distant sea
+    (long, thick paths) more than the sea below the camera (short path, sea emission)."""
+    cam = rs.make_camera(64, 80, hfov_deg=30.0, altitude_m=20.0, pitch_deg=-2.0, batch_size=2, dtype=torch.float64)
+    t_atm = rs.atmosphere.surface_air_temperature("midlatitude_summer")
+    base = rs.render(cam, rs.SeaScene(wind_speed=8.0, sea_temperature=290.0), output="brightness_temperature")
+    air = torch.tensor([t_atm, t_atm + 10.0], dtype=torch.float64)
+    warm = rs.render(cam, rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, air_temperature=air), output="brightness_temperature")
+    assert torch.equal(warm[0], base[0])
+    geom = rs.view_geometry(cam)
+    d = (warm[1] - base[1])[0]
+    sky, sea = ~geom.is_sea[1], geom.is_sea[1]
+    horizon_sky = sky & (geom.cos_view_zenith[1] < 0.01)  # within ~0.6 deg above the horizon
+    assert 9.0 < float(d[horizon_sky].min()) <= float(d[horizon_sky].max()) < 10.0
+    far = sea & (geom.range_m[1] > 1000.0)
+    near = sea & (geom.range_m[1] < 120.0)
+    assert float(d[far].mean()) > 2.0 * float(d[near].mean()) > 0.0
+    with pytest.raises(ValueError, match="air_temperature"):
+        rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, sky=10.0, air_temperature=290.0)
+    with pytest.raises(ValueError, match="air_temperature"):
+        rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, air_temperature=400.0)

@@ -1,0 +1,188 @@
+"""RandomSeaBackground and SceneSampler: kornia conventions, reproducibility, and physics of the
+compositing and of the parameters' plumbing into the renderer."""
+
+from __future__ import annotations
+
+import math
+
+import kornia.augmentation as K
+import pytest
+import torch
+
+import roughsea_torch as rs
+from roughsea_torch.augmentation import RandomSeaBackground, SceneSampler, render_parameters
+
+H, W = 24, 32
+
+
+def small(**kw):
+    kw.setdefault("output", "brightness_temperature")
+    return RandomSeaBackground(**kw)
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+@pytest.mark.parametrize("channels", [1, 3])
+def test_shape_dtype_and_values(dtype, channels):
+    aug = small(sea_temperature=(285.0, 300.0))
+    x = torch.zeros(3, channels, H, W, dtype=dtype)
+    y = aug(x, generator=torch.Generator().manual_seed(1))
+    assert y.shape == x.shape and y.dtype == dtype
+    # every channel carries the same rendered image, and every value is a plausible temperature
+    assert torch.equal(y[:, :1].expand_as(y), y)
+    assert bool(((y > 200.0) & (y < 310.0)).all())
+
+
+def test_keepdim_unbatched_input():
+    aug = small(keepdim=True)
+    y = aug(torch.zeros(1, H, W), generator=torch.Generator().manual_seed(0))
+    assert y.shape == (1, H, W)
+
+
+def test_replay_and_seeding():
+    aug = small(wind_speed=(0.5, 20.0), atmospheres=["tropical", "subarctic_winter", "us_standard"],
+                air_temperature=(260.0, 300.0))
+    x = torch.zeros(4, 1, H, W)
+    a = aug(x, generator=torch.Generator().manual_seed(7))
+    params = {k: v.clone() for k, v in aug._params.items()}
+    assert torch.equal(aug(x, params=params), a)  # replay from the kept parameters
+    assert torch.equal(aug(x, generator=torch.Generator().manual_seed(7)), a)  # same seed, same batch
+    b = aug(x, generator=torch.Generator().manual_seed(8))
+    assert not torch.equal(a, b)
+    torch.manual_seed(3)
+    c = aug(x)
+    torch.manual_seed(3)
+    assert torch.equal(aug(x), c)  # no generator: the global one
+
+
+def test_draws_within_ranges_and_fixed_values():
+    s = SceneSampler(wind_speed=(2.0, 4.0), pitch_deg=-3.0, hfov_deg=(10.0, 12.0), atmospheres=["tropical", "us_standard"])
+    p = s.sample(500, generator=torch.Generator().manual_seed(0))
+    assert bool(((p["wind_speed"] >= 2.0) & (p["wind_speed"] <= 4.0)).all())
+    assert float(p["wind_speed"].max() - p["wind_speed"].min()) > 1.9  # spread over the range
+    assert torch.equal(p["pitch_deg"], torch.full((500,), -3.0, dtype=torch.float64))
+    assert set(p["atmosphere"].tolist()) == {0, 1}
+    # air temperature left out: each image gets its atmosphere's own surface air temperature
+    own = torch.tensor([rs.atmosphere.surface_air_temperature(n) for n in ("tropical", "us_standard")], dtype=torch.float64)
+    assert torch.equal(p["air_temperature"], own[p["atmosphere"]])
+    # fixing one range does not change the draws of the others
+    q = SceneSampler(wind_speed=(2.0, 4.0), pitch_deg=(-5.0, -1.0), hfov_deg=(10.0, 12.0),
+                     atmospheres=["tropical", "us_standard"]).sample(500, generator=torch.Generator().manual_seed(0))
+    assert torch.equal(p["wind_speed"], q["wind_speed"]) and torch.equal(p["hfov_deg"], q["hfov_deg"])
+
+
+def test_indexed_draws_do_not_depend_on_the_batch():
+    s = SceneSampler()
+    a = s.sample_indexed(11, [5, 6, 7])
+    b = s.sample_indexed(11, [7])
+    for k in a:
+        assert torch.equal(a[k][2:], b[k])
+    c = s.sample_indexed(12, [7])
+    assert not torch.equal(c["wind_speed"], b["wind_speed"])
+
+
+def test_same_on_batch():
+    aug = small(same_on_batch=True)
+    y = aug(torch.zeros(3, 1, H, W), generator=torch.Generator().manual_seed(2))
+    assert torch.equal(y[0], y[1]) and torch.equal(y[0], y[2])
+
+
+def test_p_gates_images_and_skips_their_rendering():
+    x = torch.full((8, 1, H, W), -1.0)
+    aug = small(p=0.5)
+    y = aug(x, generator=torch.Generator().manual_seed(4))
+    gate = aug._params["batch_prob"] > 0.5
+    assert 0 < int(gate.sum()) < 8
+    assert bool((y[~gate] == -1.0).all())
+    assert bool((y[gate] > 200.0).all())
+    assert torch.equal(small(p=0.0)(x), x)
+
+
+def test_inside_augmentation_sequential_with_masks_and_boxes():
+    aug = small()
+    seq = K.AugmentationSequential(aug, K.RandomHorizontalFlip(p=1.0), data_keys=["input", "mask", "bbox_xyxy"])
+    x = torch.zeros(2, 1, H, W)
+    m = torch.zeros(2, 1, H, W)
+    m[:, :, 5:9, 2:6] = 1.0
+    boxes = torch.tensor([[[2.0, 5.0, 6.0, 9.0]]]).repeat(2, 1, 1)
+    torch.manual_seed(0)
+    y, m2, b2 = seq(x, m, boxes)
+    # the sea is rendered, then flipped; masks and boxes move with the flip only
+    assert torch.equal(m2, m.flip(-1))
+    assert torch.allclose(b2[..., 0], W - 1 - boxes[..., 2]) and torch.allclose(b2[..., 2], W - 1 - boxes[..., 0])  # kornia: x -> W - 1 - x
+    y2, m3, _ = seq(x, m, boxes, params=seq._params)
+    assert torch.equal(y2, y) and torch.equal(m3, m2)
+
+
+def test_rendering_matches_an_explicit_scene():
+    """The parameters reach the renderer in the documented units (wind direction in degrees,
+    per-image atmospheres): a mixed-atmosphere batch equals each image rendered on its own."""
+    s = SceneSampler(atmospheres=["tropical", "midlatitude_winter"], air_temperature=(270.0, 300.0))
+    p = s.sample(4, generator=torch.Generator().manual_seed(9))
+    p["atmosphere"] = torch.tensor([0, 1, 0, 1])
+    img = render_parameters(p, H, W, s.atmospheres, dtype=torch.float64)
+    for i in range(4):
+        cam = rs.make_camera(H, W, hfov_deg=float(p["hfov_deg"][i]), altitude_m=float(p["altitude_m"][i]),
+                             pitch_deg=float(p["pitch_deg"][i]), yaw_deg=float(p["yaw_deg"][i]),
+                             roll_deg=float(p["roll_deg"][i]), dtype=torch.float64)
+        scene = rs.SeaScene(wind_speed=float(p["wind_speed"][i]), wind_direction=math.radians(float(p["wind_direction_deg"][i])),
+                            sea_temperature=float(p["sea_temperature"][i]), air_temperature=float(p["air_temperature"][i]),
+                            sky=s.atmospheres[int(p["atmosphere"][i])])
+        ref = rs.render(cam, scene)
+        torch.testing.assert_close(img[i : i + 1], ref, rtol=1e-7, atol=0.0)  # batching order only
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+def test_composite_is_alpha_blending_in_radiance(dtype):
+    aug = RandomSeaBackground(mode="composite", output="radiance")
+    x = torch.zeros(2, 2, H, W, dtype=dtype)
+    x[:, 0] = 320.0  # a hot target [K]
+    x[:, 1, :8] = 1.0  # opaque rows
+    x[:, 1, 8:16] = 0.5  # half-transparent rows
+    y = aug(x, generator=torch.Generator().manual_seed(0))
+    sea = RandomSeaBackground(output="radiance")(x[:, :1], params=aug._params)
+    t = rs.band_radiance(torch.tensor(320.0, dtype=dtype), rs.LWIR)
+    torch.testing.assert_close(y[:, 0, :8], t.expand(2, 8, W))
+    torch.testing.assert_close(y[:, 0, 8:16], 0.5 * (t + sea[:, 0, 8:16]))
+    torch.testing.assert_close(y[:, 0, 16:], sea[:, 0, 16:], rtol=0, atol=0)
+    assert torch.equal(y[:, 1], x[:, 1])  # alpha passes through
+    # a half-covering 320 K target over a ~290 K sea is warmer than the temperature average:
+    # blending happens in radiance, which is convex in temperature
+    bt = rs.brightness_temperature(y[:, 0, 8:16], rs.LWIR)
+    bt_sea = rs.brightness_temperature(sea[:, 0, 8:16], rs.LWIR)
+    assert bool((bt > 0.5 * (320.0 + bt_sea)).all())
+
+
+def test_gradient_to_target_temperature():
+    aug = RandomSeaBackground(mode="composite", output="brightness_temperature")
+    x = torch.zeros(1, 2, H, W, dtype=torch.float64)
+    x[:, 1, 4:8, 4:8] = 0.3
+    x[:, 0] = 310.0
+    x.requires_grad_(True)
+    y = aug(x, generator=torch.Generator().manual_seed(0))
+    (g,) = torch.autograd.grad(y[:, 0].sum(), x)
+    assert torch.isfinite(g).all()
+    assert bool((g[0, 0, 4:8, 4:8] > 0.2).all()) and bool((g[0, 0, 4:8, 4:8] < 1.0).all())
+    assert float(g[0, 0, 10:].abs().max()) == 0.0  # α = 0: the target does not show
+
+
+@pytest.mark.parametrize(
+    "kwargs, key",
+    [
+        (dict(wind_speed=(10.0, 2.0)), "wind_speed"),
+        (dict(altitude_m=(-5.0, 10.0)), "altitude_m"),
+        (dict(pitch_deg=(-95.0, 0.0)), "pitch_deg"),
+        (dict(sea_temperature="warm"), "sea_temperature"),
+        (dict(atmospheres=["martian"]), "atmospheres"),
+        (dict(atmospheres=[]), "atmospheres"),
+        (dict(mode="paste"), "mode"),
+        (dict(output="counts"), "output"),
+    ],
+)
+def test_bad_arguments_name_the_key(kwargs, key):
+    with pytest.raises(ValueError, match=key):
+        RandomSeaBackground(**kwargs)
+
+
+def test_composite_needs_two_channels():
+    with pytest.raises(ValueError, match="2 channels"):
+        RandomSeaBackground(mode="composite")(torch.zeros(1, 1, H, W))
