@@ -277,6 +277,10 @@ def test_air_temperature_shifts_sky_and_path():
     air = torch.tensor([t_atm, t_atm + 10.0], dtype=torch.float64)
     warm = rs.render(cam, rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, air_temperature=air), output="brightness_temperature")
     assert torch.equal(warm[0], base[0])
+    # the table method scales the reflected-sky term, the direct one a per-image sky table: same image
+    direct = rs.render(cam, rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, air_temperature=air), method="direct")
+    table = rs.render(cam, rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, air_temperature=air))
+    torch.testing.assert_close(table, direct, rtol=2e-5, atol=0.0)
     geom = rs.view_geometry(cam)
     d = (warm[1] - base[1])[0]
     sky, sea = ~geom.is_sea[1], geom.is_sea[1]
