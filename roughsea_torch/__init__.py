@@ -37,8 +37,10 @@ from .geometry import EARTH_RADIUS_M, ViewGeometry, make_camera, view_geometry
 from .render import SeaRenderer, SeaScene, TableSize, render
 from .sensitivity import pixel_derivative
 from .slopes import SlopeStatistics, slope_pdf
-from . import atmosphere, augmentation  # noqa: E402  (submodules as attributes: rs.atmosphere, ...)
+from . import atmosphere, augmentation, dataset, sensor  # noqa: E402  (submodules as attributes: rs.sensor, ...)
 from .augmentation import RandomSeaBackground, SceneSampler
+from .dataset import SeaShardDataset
+from .sensor import SensorModel
 
 __version__ = "0.1.0"
 
@@ -54,6 +56,8 @@ __all__ = [
     "Quadrature",
     "RandomSeaBackground",
     "SceneSampler",
+    "SeaShardDataset",
+    "SensorModel",
     "SlopeStatistics",
     "SpectralBand",
     "TabulatedSky",

@@ -186,3 +186,19 @@ def test_bad_arguments_name_the_key(kwargs, key):
 def test_composite_needs_two_channels():
     with pytest.raises(ValueError, match="2 channels"):
         RandomSeaBackground(mode="composite")(torch.zeros(1, 1, H, W))
+
+
+def test_sensor_output_replays_with_its_noise():
+    from roughsea_torch.sensor import SensorModel
+
+    aug = RandomSeaBackground(sensor=SensorModel.typical_lwir(), same_on_batch=True)
+    x = torch.zeros(2, 1, H, W)
+    y = aug(x, generator=torch.Generator().manual_seed(0))
+    assert torch.equal(y, y.round()) and float(y.min()) >= 0 and float(y.max()) <= 2**14 - 1  # 14-bit counts
+    assert torch.equal(aug(x, params=aug._params), y)  # the noise replays too
+    # same scene on both images (same_on_batch) but the temporal noise differs with the noise seed
+    params = {k: v.clone() for k, v in aug._params.items()}
+    params["noise_seed"] = torch.tensor([1, 2])
+    z = aug(x, params=params)
+    d = (z[0] - z[1]).float()
+    assert float(d.abs().max()) > 0 and abs(float(d.mean())) < 3.0 * float(d.std()) / d.numel() ** 0.5 + 1.0

@@ -1,0 +1,372 @@
+"""The sensor model (roughsea_torch.sensor): blur, temporal noise, fixed pattern, ADC, display, chain.
+
+Statistical tolerances are set from the sample size N: the sample standard deviation of N normal
+draws has a relative standard error 1/√(2(N − 1)), and a sample mean σ/√N; every bound below is at
+least 5 such standard errors, with seeded generators so that the tests are deterministic anyway.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import torch
+
+from roughsea_torch.radiometry import LWIR, MWIR, band_radiance, brightness_temperature
+from roughsea_torch.sensor import (
+    DetectorNoise,
+    FixedPatternNoise,
+    OpticsBlur,
+    SensorModel,
+    ToCounts,
+    ToDisplay,
+    counts_to_radiance,
+    detector_noise,
+    noise_equivalent_radiance,
+    optics_blur,
+    radiance_to_counts,
+    to_display,
+)
+
+DEVICES = ["cpu", pytest.param("cuda", marks=pytest.mark.skipif(not torch.cuda.is_available(), reason="no CUDA"))]
+DTYPES = [torch.float32, torch.float64]
+
+
+@pytest.fixture(params=DEVICES)
+def device(request: pytest.FixtureRequest) -> torch.device:
+    return torch.device(request.param)
+
+
+@pytest.fixture(params=DTYPES, ids=["float32", "float64"])
+def dtype(request: pytest.FixtureRequest) -> torch.dtype:
+    return request.param
+
+
+def eps(dtype: torch.dtype) -> float:
+    return torch.finfo(dtype).eps
+
+
+def gen(seed: int) -> torch.Generator:
+    return torch.Generator().manual_seed(seed)
+
+
+def uniform_image(T: float, shape, dtype, device, band=LWIR) -> torch.Tensor:
+    return band_radiance(torch.full(shape, T, dtype=dtype, device=device), band)
+
+
+# ------------------------------------------------------------------------------------------------
+# OpticsBlur
+
+
+def test_blur_conserves_mean_reduces_variance_and_keeps_constants(dtype, device):
+    """Content farther from the border than the kernel radius keeps its sum exactly (normalized
+    kernel); a noise image loses variance; a constant image is unchanged (reflected border)."""
+    sigma = 1.5  # kernel 2⌈4σ⌉ + 1 = 13, radius 6 < the 12-pixel margin below
+    x = torch.zeros(2, 1, 48, 48, dtype=dtype, device=device)
+    x[:, :, 12:36, 12:36] = 10.0 + torch.rand(2, 1, 24, 24, generator=gen(0), dtype=dtype).to(device)
+    y = optics_blur(x, sigma)
+    assert y.shape == x.shape and y.dtype == dtype and y.device.type == device.type
+    torch.testing.assert_close(y.sum((1, 2, 3)), x.sum((1, 2, 3)), rtol=50 * eps(dtype), atol=0.0)
+    assert not torch.equal(y, x)
+
+    noise = torch.randn(2, 1, 48, 48, generator=gen(1), dtype=dtype).to(device)
+    assert (OpticsBlur(sigma)(noise).var((1, 2, 3)) < 0.2 * noise.var((1, 2, 3))).all()
+
+    const = torch.full((2, 3, 17, 9), 38.5, dtype=dtype, device=device)
+    torch.testing.assert_close(OpticsBlur(0.7)(const), const, rtol=10 * eps(dtype), atol=0.0)
+    assert torch.equal(x, x.clone())  # input not edited (sanity of the line above)
+
+
+def test_blur_per_image_sigma_matches_a_loop_and_zero_is_identity(dtype, device):
+    x = torch.rand(3, 2, 20, 24, generator=gen(2), dtype=dtype).to(device)
+    sigma = torch.tensor([0.0, 0.7, 2.0], dtype=dtype, device=device)
+    y = optics_blur(x, sigma, kernel_size=15)
+    for i in range(3):
+        yi = optics_blur(x[i : i + 1], float(sigma[i]), kernel_size=15)
+        torch.testing.assert_close(y[i : i + 1], yi, rtol=10 * eps(dtype), atol=10 * eps(dtype))
+    assert torch.equal(y[0], x[0])  # σ = 0: the unit impulse
+    assert torch.equal(optics_blur(x, 0.0), x)
+    # the automatic kernel never exceeds what a reflected border allows on a tiny image
+    assert optics_blur(x[:, :, :3, :4], 5.0).shape == (3, 2, 3, 4)
+
+
+def test_blur_gradcheck_image_and_sigma():
+    x = torch.rand(2, 1, 7, 8, dtype=torch.float64, generator=gen(3)).requires_grad_()
+    s = torch.tensor([0.8, 1.3], dtype=torch.float64, requires_grad=True)
+    assert torch.autograd.gradcheck(lambda a, b: optics_blur(a, b, kernel_size=5), (x, s), fast_mode=True)
+
+
+# ------------------------------------------------------------------------------------------------
+# DetectorNoise
+
+
+@pytest.mark.parametrize("band", [LWIR, MWIR], ids=["LWIR", "MWIR"])
+def test_detector_noise_has_the_netd_in_kelvin_and_zero_mean(dtype, device, band):
+    """Uniform 300 K image, N = 65 536 pixels: the std of the brightness temperature of the noisy
+    image is the NETD (relative standard error 1/√(2N) = 0.28 %; bound 2 % ≈ 7 s.e.), and the
+    noise mean is within 5 σ/√N of zero."""
+    netd = 0.05
+    L = uniform_image(300.0, (4, 1, 128, 128), dtype, device, band)
+    y = DetectorNoise(netd_k=netd, band=band)(L, generator=gen(0))
+    n = L.numel()
+    T = brightness_temperature(y, band).double()
+    assert abs(T.std().item() / netd - 1.0) < 0.02
+    sigma_L = noise_equivalent_radiance(netd, 300.0, band).item()
+    assert abs((y - L).double().mean().item()) < 5 * sigma_L / math.sqrt(n)
+    assert abs(T.mean().item() - 300.0) < 5 * netd / math.sqrt(n) + 1e-4
+
+
+def test_detector_noise_per_pixel_versus_reference_temperature(dtype, device):
+    """Per-pixel mode: the noise is NETD in kelvin on a cold and a hot half alike; with a fixed
+    reference temperature the noise is one radiance σ = NETD·dL/dT(T_ref) everywhere (so more
+    kelvin on the cold half). Halves of 32 768 pixels: 2.8 % bound ≈ 7 s.e."""
+    netd = 0.05
+    T = torch.cat([torch.full((2, 1, 128, 64), 260.0), torch.full((2, 1, 128, 64), 320.0)], dim=-1)
+    L = band_radiance(T.to(dtype=dtype, device=device))
+    y = detector_noise(L, netd, generator=gen(1))
+    Tb = brightness_temperature(y).double()
+    for half in (Tb[..., :64], Tb[..., 64:]):
+        assert abs(half.std().item() / netd - 1.0) < 0.028
+    y_ref = DetectorNoise(netd, reference_temperature=300.0)(L, generator=gen(1))
+    sigma_ref = noise_equivalent_radiance(netd, 300.0).item()
+    for half in ((y_ref - L)[..., :64], (y_ref - L)[..., 64:]):
+        assert abs(half.double().std().item() / sigma_ref - 1.0) < 0.028
+    # same draws, scaled: the ratio of the two noises is dL/dT(T_pixel) / dL/dT(300 K) exactly
+    ratio = (y - L).double()[..., :64].std() / (y_ref - L).double()[..., :64].std()
+    expect = (noise_equivalent_radiance(netd, 260.0) / sigma_ref).item()
+    assert abs(ratio.item() / expect - 1.0) < 1e-3
+
+
+def test_noise_equivalent_radiance_is_the_derivative_of_band_radiance():
+    T = torch.tensor([250.0, 300.0, 330.0], dtype=torch.float64)
+    h = 1e-3
+    fd = (band_radiance(T + h) - band_radiance(T - h)) / (2 * h)
+    torch.testing.assert_close(noise_equivalent_radiance(1.0, T), fd, rtol=1e-8, atol=0.0)
+    assert noise_equivalent_radiance(0.05, torch.tensor(300.0, dtype=torch.float32)).dtype == torch.float32
+
+
+def test_detector_noise_generator_reproducible_and_per_image_netd(dtype, device):
+    L = uniform_image(290.0, (2, 1, 16, 16), dtype, device)
+    a = detector_noise(L, generator=gen(5))
+    assert torch.equal(a, detector_noise(L, generator=gen(5)))
+    assert not torch.equal(a, detector_noise(L, generator=gen(6)))
+    torch.manual_seed(7)
+    b = detector_noise(L)
+    torch.manual_seed(7)
+    assert torch.equal(b, detector_noise(L))  # generator=None: the global RNG
+    y = detector_noise(L, torch.tensor([0.0, 0.1], dtype=dtype), generator=gen(5))
+    assert torch.equal(y[0], L[0]) and not torch.equal(y[1], L[1])
+
+
+# ------------------------------------------------------------------------------------------------
+# FixedPatternNoise
+
+
+def test_fixed_pattern_is_fixed_per_seed(dtype, device):
+    L = band_radiance(torch.linspace(270, 310, 24 * 32).reshape(1, 1, 24, 32).to(dtype=dtype, device=device))
+    fpn = FixedPatternNoise(seed=3)
+    a = fpn(L)
+    assert a.dtype == dtype and a.shape == L.shape
+    assert torch.equal(a, fpn(L))  # same on every call
+    assert torch.equal(a, FixedPatternNoise(seed=3)(L))  # a function of the seed alone
+    assert not torch.equal(a, FixedPatternNoise(seed=4)(L))
+    assert torch.equal(fpn(L.expand(3, 2, -1, -1)), a.expand(3, 2, -1, -1))  # same on every image and channel
+    g64, o64 = fpn.pattern(24, 32, torch.float64)
+    g, o = fpn.pattern(24, 32, dtype, device)
+    torch.testing.assert_close(g.double().cpu(), g64, rtol=eps(dtype), atol=0.0)
+    torch.testing.assert_close(o.double().cpu(), o64, rtol=eps(dtype), atol=0.0)
+
+
+def test_fixed_pattern_spatial_statistics_match_parameters():
+    """Each component alone, measured in kelvin through brightness_temperature at T_ref = 300 K
+    (or through the gain at 330 K): pixel offset and gain over 128×128 = 16 384 pixels (s.e.
+    0.55 %, bound 3 %), columns over 4 096 columns (s.e. 1.1 %, bound 6 %)."""
+    T_ref = 300.0
+    L_ref = uniform_image(T_ref, (1, 1, 128, 128), torch.float64, "cpu")
+    pix = FixedPatternNoise(gain_std=0.0, offset_std_k=0.1, column_std_k=0.0, seed=1)(L_ref)
+    dT = brightness_temperature(pix) - T_ref
+    assert abs(dT.std().item() / 0.1 - 1.0) < 0.03
+    assert abs(dT.mean().item()) < 5 * 0.1 / 128
+
+    L_col = uniform_image(T_ref, (1, 1, 8, 4096), torch.float64, "cpu")
+    col = FixedPatternNoise(gain_std=0.0, offset_std_k=0.0, column_std_k=0.05, seed=1)(L_col)
+    assert torch.equal(col, col[:, :, :1].expand_as(col))  # stripes: every row the same
+    assert abs((brightness_temperature(col[0, 0, 0]) - T_ref).std().item() / 0.05 - 1.0) < 0.06
+
+    L_hot = uniform_image(330.0, (1, 1, 128, 128), torch.float64, "cpu")
+    fpn = FixedPatternNoise(gain_std=0.01, offset_std_k=0.0, column_std_k=0.0, seed=1)
+    l_ref = band_radiance(torch.tensor(T_ref, dtype=torch.float64))
+    rel = (fpn(L_hot) - l_ref) / (L_hot - l_ref) - 1.0
+    assert abs(rel.std().item() / 0.01 - 1.0) < 0.03
+    # gain errors pivot about the calibration point: at T_ref the image is unchanged
+    torch.testing.assert_close(fpn(L_ref), L_ref, rtol=1e-14, atol=0.0)
+
+
+# ------------------------------------------------------------------------------------------------
+# ToCounts
+
+
+def test_to_counts_values_clamp_and_inverse(dtype, device):
+    adc = ToCounts(bits=14, temperature_range=(250.0, 330.0))
+    L64 = band_radiance(torch.tensor([250.0, 300.0, 330.0], dtype=torch.float64))
+    expect_300 = round(((L64[1] - L64[0]) / (L64[2] - L64[0]) * 16383).item())  # 8579.98 → 8580
+    T = torch.tensor([200.0, 250.0, 300.0, 330.0, 400.0], dtype=dtype, device=device)
+    c = adc(band_radiance(T).view(1, 1, 1, 5))
+    assert c.dtype == dtype and c.device.type == device.type
+    assert c.flatten().tolist() == [0.0, 0.0, float(expect_300), 16383.0, 16383.0]
+    assert adc.full_scale == 16383
+
+    T = 255.0 + 70.0 * torch.rand(2, 1, 30, 30, generator=gen(0), dtype=torch.float64)
+    L = band_radiance(T).to(dtype=dtype, device=device)
+    c = adc(L)
+    assert torch.equal(c, c.round()) and c.min() > 0 and c.max() < 16383
+    err_counts = (adc.counts_to_radiance(c) - L).abs() * adc.gain
+    assert err_counts.max().item() <= 0.5 + 16383 * 4 * eps(dtype)
+    # integer counts (as a camera delivers them) are accepted by the inverse
+    back = counts_to_radiance(c.to(torch.int32), adc.gain, adc.offset)
+    torch.testing.assert_close(back.double(), adc.counts_to_radiance(c).double(), rtol=2 * eps(torch.float32), atol=0.0)
+
+    assert ToCounts(bits=8)(band_radiance(torch.full((1, 1, 1, 1), 400.0, dtype=dtype))).item() == 255.0
+    same = ToCounts(radiance_range=(L64[0].item(), L64[2].item()))
+    assert same.gain == pytest.approx(adc.gain, rel=1e-14) and same.offset == pytest.approx(adc.offset, rel=1e-12)
+
+
+def test_to_counts_straight_through_gradient(dtype, device):
+    adc = ToCounts()
+    L = band_radiance(torch.tensor([200.0, 260.0, 300.0, 320.0, 400.0], dtype=dtype, device=device))
+    L = L.view(1, 1, 1, 5).requires_grad_()
+    adc(L).sum().backward()
+    g = L.grad.flatten()
+    assert torch.isfinite(g).all()
+    torch.testing.assert_close(g[1:4], torch.full_like(g[1:4], adc.gain), rtol=eps(dtype), atol=0.0)
+    assert g[0].item() == 0.0 and g[4].item() == 0.0  # clamped
+    # the rounding-free ADC has the same gradient, and values differing by < 0.5 count
+    Lf = L.detach()
+    assert (radiance_to_counts(Lf, adc.gain, adc.offset, rounding=False) - adc(Lf)).abs().max() <= 0.5
+
+
+# ------------------------------------------------------------------------------------------------
+# ToDisplay
+
+
+def test_to_display_percentiles_monotone_and_range(dtype, device):
+    """101 values per image: the 1st and 99th percentiles are exactly the 2nd and 100th values,
+    which must map to 0 and 255; two images with different scales are stretched separately."""
+    base = torch.arange(101, dtype=dtype, device=device)
+    x = torch.stack([base, 1000.0 + torch.exp(base / 20.0)]).view(2, 1, 1, 101).flip(-1)
+    y = ToDisplay(1.0, 99.0)(x)
+    assert y.dtype == dtype and y.shape == x.shape
+    assert y.min() == 0 and y.max() == 255 and torch.equal(y, y.round())
+    for i in range(2):
+        order = torch.argsort(x[i].flatten())
+        yi = y[i].flatten()[order]
+        assert (yi.diff() >= 0).all()  # monotone in the input
+        assert yi[0] == 0 and yi[1] == 0 and yi[99] == 255 and yi[100] == 255
+        assert 0 < yi[50] < 255
+    u8 = to_display(x, output_dtype=torch.uint8)
+    assert u8.dtype == torch.uint8 and torch.equal(u8.to(dtype), y)
+    # agrees with torch.quantile on a random image (up to rounding ties)
+    r = torch.rand(3, 2, 20, 30, generator=gen(0), dtype=dtype).to(device)
+    q = torch.quantile(r.flatten(1), torch.tensor([0.05, 0.95], dtype=dtype, device=device), dim=1)
+    lo, hi = q[0].view(3, 1, 1, 1), q[1].view(3, 1, 1, 1)
+    ref = (255 * ((r - lo) / (hi - lo)).clamp(0, 1)).round()
+    assert (to_display(r, 5.0, 95.0) - ref).abs().max() <= 1
+    # a constant image gives 0, not NaN
+    assert torch.equal(to_display(torch.ones(1, 1, 4, 4, dtype=dtype)), torch.zeros(1, 1, 4, 4, dtype=dtype))
+
+
+def test_to_display_beyond_the_torch_quantile_limit():
+    """2²⁴ + 2 pixels (torch.quantile refuses more than 2²⁴): the percentiles of the values
+    0 … N − 1 (exact in float32 below 2²⁴) are p·(N − 1)."""
+    n = 2**24 + 2
+    x = torch.arange(n, dtype=torch.float32).flip(0).view(1, 1, 2, n // 2)
+    y = to_display(x)
+    lo, hi = 0.01 * (n - 1), 0.99 * (n - 1)
+    assert y.min() == 0 and y.max() == 255
+    assert (y[x <= lo] == 0).all() and (y[x >= hi] == 255).all()
+    mid = x.flatten()[n // 2].item()
+    assert y.flatten()[n // 2].item() == round(255 * (mid - lo) / (hi - lo))
+
+
+# ------------------------------------------------------------------------------------------------
+# SensorModel
+
+
+def scene(dtype, device, B=2, H=32, W=40):
+    T = 280.0 + 20.0 * torch.rand(B, 1, H, W, generator=gen(11), dtype=torch.float64)
+    return band_radiance(T).to(dtype=dtype, device=device)
+
+
+def test_sensor_model_reproducible_and_differentiable(dtype, device):
+    L = scene(dtype, device)
+    sensor = SensorModel.typical_lwir()
+    a = sensor(L, generator=gen(0))
+    assert a.dtype == dtype and a.shape == L.shape and a.device.type == device.type
+    assert torch.equal(a, sensor(L, generator=gen(0)))  # bitwise
+    assert torch.equal(a, SensorModel.typical_lwir()(L, generator=gen(0)))
+    assert not torch.equal(a, sensor(L, generator=gen(1)))
+    assert torch.equal(a, a.round()) and a.min() >= 0 and a.max() <= 16383
+    Lg = L.clone().requires_grad_()
+    sensor(Lg, generator=gen(0)).sum().backward()
+    assert torch.isfinite(Lg.grad).all() and Lg.grad.abs().sum() > 0
+
+
+def test_sensor_model_stages_none_and_composition(dtype, device):
+    L = scene(dtype, device)
+    assert torch.equal(SensorModel()(L, generator=gen(0)), L)  # all None: identity
+    adc = ToCounts()
+    assert torch.equal(SensorModel(counts=adc)(L), adc(L))
+    blur, noise, fpn, disp = OpticsBlur(1.0), DetectorNoise(0.08), FixedPatternNoise(seed=2), ToDisplay()
+    chained = SensorModel(blur, noise, fpn, adc, disp)(L, generator=gen(4))
+    by_hand = disp(adc(fpn(noise(blur(L), generator=gen(4)))))
+    assert torch.equal(chained, by_hand)
+    # any module works as a stage; one without a generator argument is called without it
+    assert torch.equal(SensorModel(blur=torch.nn.Identity(), counts=adc)(L, generator=gen(0)), adc(L))
+    # without temporal noise the chain is deterministic and batched equals looped
+    quiet = SensorModel(blur=OpticsBlur(0.7), fixed_pattern=FixedPatternNoise(), counts=ToCounts())
+    looped = torch.cat([quiet(L[i : i + 1]) for i in range(L.shape[0])])
+    assert torch.equal(quiet(L), looped)
+
+
+@pytest.mark.skipif(not torch.cuda.is_available(), reason="no CUDA")
+def test_cpu_generator_gives_the_same_noise_on_cuda():
+    L = scene(torch.float64, "cpu")
+    a = detector_noise(L, generator=gen(3))
+    b = detector_noise(L.cuda(), generator=gen(3)).cpu()
+    torch.testing.assert_close(a, b, rtol=1e-12, atol=0.0)
+
+
+@pytest.mark.parametrize(
+    "make, name",
+    [
+        (lambda: OpticsBlur(sigma_px=-1.0), "sigma_px"),
+        (lambda: OpticsBlur(sigma_px=float("nan")), "sigma_px"),
+        (lambda: OpticsBlur(kernel_size=4), "kernel_size"),
+        (lambda: optics_blur(torch.ones(2, 1, 8, 8), torch.ones(3)), "sigma_px"),
+        (lambda: optics_blur(torch.ones(1, 1, 4, 4), 1.0, kernel_size=9), "kernel_size"),
+        (lambda: DetectorNoise(netd_k=-0.01), "netd_k"),
+        (lambda: DetectorNoise(reference_temperature=0.0), "reference_temperature"),
+        (lambda: FixedPatternNoise(gain_std=-0.1), "gain_std"),
+        (lambda: FixedPatternNoise(offset_std_k=float("inf")), "offset_std_k"),
+        (lambda: FixedPatternNoise(column_std_k=-1.0), "column_std_k"),
+        (lambda: FixedPatternNoise(seed=-1), "seed"),
+        (lambda: FixedPatternNoise(seed=1.5), "seed"),
+        (lambda: ToCounts(bits=0), "bits"),
+        (lambda: ToCounts(bits=32), "bits"),
+        (lambda: ToCounts(gain=10.0), "offset"),
+        (lambda: ToCounts(gain=-1.0, offset=0.0), "gain"),
+        (lambda: ToCounts(temperature_range=(330.0, 250.0)), "temperature_range"),
+        (lambda: ToCounts(radiance_range=(1.0,)), "radiance_range"),
+        (lambda: ToDisplay(low_percentile=99.0, high_percentile=1.0), "low_percentile"),
+        (lambda: ToDisplay(high_percentile=101.0), "high_percentile"),
+        (lambda: ToDisplay(output_dtype=torch.int16), "output_dtype"),
+        (lambda: SensorModel(blur=lambda x: x), "blur"),
+        (lambda: SensorModel()(torch.ones(1, 8, 8)), "radiance"),
+        (lambda: SensorModel()(torch.ones(1, 1, 8, 8, dtype=torch.float16)), "radiance"),
+        (lambda: ToCounts()([[1.0]]), "radiance"),
+        (lambda: to_display(torch.ones(4, 4)), "image"),
+    ],
+)
+def test_bad_arguments_raise_value_error_naming_the_argument(make, name):
+    with pytest.raises(ValueError, match=name):
+        make()
