@@ -66,7 +66,7 @@ class TabulatedSky:
 
     Example:
         >>> sky = TabulatedSky(torch.tensor([0.0, 1.0, 1.5707963]), torch.tensor([11.0, 14.0, 40.0]))
-        >>> float(sky(torch.tensor(1.0)))
+        >>> round(float(sky(torch.tensor(1.0))), 4)
         11.0
     """
 
@@ -93,12 +93,29 @@ class TabulatedSky:
         self._cache: dict[tuple[torch.dtype, torch.device], tuple[torch.Tensor, ...]] = {}
 
     def _tables(self, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, ...]:
+        """Per (dtype, device): the nodes z, radiance r, PCHIP slopes d, and for the lookup a
+        uniform bucket grid over [z₀, z_end] (origin, 1/width, first interval of each bucket) whose
+        width is the smallest node spacing, so a bucket meets at most two intervals; for a single
+        table also the power-form coefficients (N−1, 4) of each interval in t ∈ [0, 1]."""
         key = (dtype, device)
         if self.radiance.requires_grad or key not in self._cache:
+            z64 = self.zenith.detach().double().cpu()
+            h64 = z64[1:] - z64[:-1]
+            width = float(h64.min())
+            m = int(math.ceil(float(z64[-1] - z64[0]) / width)) + 1
+            edges = z64[0] + width * torch.arange(m, dtype=torch.float64)
+            start = (torch.searchsorted(z64, edges, right=True) - 1).clamp(0, z64.numel() - 2)
             z = self.zenith.to(dtype=dtype, device=device)
             r = self.radiance.to(dtype=dtype, device=device)
             d = pchip_derivatives(z, r)
-            out = (z, r, d)
+            bucket = (torch.tensor(float(z64[0]), dtype=dtype, device=device),
+                      torch.tensor(1.0 / width, dtype=dtype, device=device), start.to(device))
+            coef = None
+            if r.ndim == 1:  # y(t) = y0 + t (h d0 + t (3Δ − h(2 d0 + d1) + t (−2Δ + h(d0 + d1))))
+                h = z[1:] - z[:-1]
+                dy = r[1:] - r[:-1]
+                coef = torch.stack([r[:-1], h * d[:-1], 3 * dy - h * (2 * d[:-1] + d[1:]), -2 * dy + h * (d[:-1] + d[1:])], -1)
+            out = (z, r, d, *bucket, coef)
             if self.radiance.requires_grad:
                 return out
             self._cache[key] = out
@@ -106,24 +123,29 @@ class TabulatedSky:
 
     def __call__(self, cos_zenith: torch.Tensor) -> torch.Tensor:
         cz = cos_zenith
-        z, r, d = self._tables(cz.dtype, cz.device)
+        z, r, d, z0, inv_w, start, coef = self._tables(cz.dtype, cz.device)
         # acos has an infinite slope at cos = 1: hold the query a rounding step away from it.
         one = 1.0 - torch.finfo(cz.dtype).eps
         theta = torch.acos(cz.clamp(0.0, one))
         theta = torch.minimum(torch.maximum(theta, z[0]), z[-1])
-        i = torch.searchsorted(z, theta.detach().contiguous(), right=True).clamp(1, z.numel() - 1) - 1
-        x0, x1 = z[i], z[i + 1]
-        h = x1 - x0
+        # interval index: the bucket's first interval, plus one where θ is past its end (a
+        # gather and a compare instead of a binary search)
+        th = theta.detach()
+        i = start[((th - z0) * inv_w).long().clamp(0, start.numel() - 1)]
+        i = i + (th >= z[i + 1]).long()
+        i = i.clamp(max=z.numel() - 2)
+        x0 = z[i]
+        h = z[i + 1] - x0
         t = (theta - x0) / h
-        if r.ndim == 1:
-            y0, y1, d0, d1 = r[i], r[i + 1], d[i], d[i + 1]
-        else:
-            lead = torch.broadcast_shapes(r.shape[:-1], i.shape[:-1])
-            rb = r.expand(*lead, r.shape[-1])
-            db = d.expand(*lead, d.shape[-1])
-            ib = i.expand(*lead, i.shape[-1])
-            y0, y1 = rb.gather(-1, ib), rb.gather(-1, ib + 1)
-            d0, d1 = db.gather(-1, ib), db.gather(-1, ib + 1)
+        if coef is not None:
+            c = coef[i]  # one gather of the interval's four coefficients
+            return c[..., 0] + t * (c[..., 1] + t * (c[..., 2] + t * c[..., 3]))
+        lead = torch.broadcast_shapes(r.shape[:-1], i.shape[:-1])
+        rb = r.expand(*lead, r.shape[-1])
+        db = d.expand(*lead, d.shape[-1])
+        ib = i.expand(*lead, i.shape[-1])
+        y0, y1 = rb.gather(-1, ib), rb.gather(-1, ib + 1)
+        d0, d1 = db.gather(-1, ib), db.gather(-1, ib + 1)
         t2 = t * t
         t3 = t2 * t
         h00 = 2 * t3 - 3 * t2 + 1

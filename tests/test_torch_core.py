@@ -204,6 +204,15 @@ def test_pchip_matches_scipy():
     expected = PchipInterpolator(zen, rad)(q)
     got = rs.TabulatedSky(torch.tensor(zen), torch.tensor(rad))(torch.cos(torch.tensor(q))).numpy()
     np.testing.assert_allclose(got, expected, rtol=1e-10, atol=1e-10)
+    # the shipped LOWTRAN nodes (0.1 deg near the horizon, coarser above), queried at the nodes,
+    # between them and from a batched table (the interval lookup is a bucket grid, not a search)
+    sky = rs.atmosphere.load_sky("tropical", dtype=torch.float64)
+    z = sky.zenith.numpy()
+    qz = np.concatenate([z, 0.5 * (z[1:] + z[:-1]), rng.uniform(z[0], z[-1], 2000)])
+    want = PchipInterpolator(z, sky.radiance.numpy())(qz)
+    np.testing.assert_allclose(sky(torch.cos(torch.tensor(qz))).numpy(), want, rtol=1e-9)
+    two = sky.with_radiance(torch.stack([sky.radiance, 0.5 * sky.radiance]))(torch.cos(torch.tensor(np.stack([qz, qz]))))
+    np.testing.assert_allclose(two.numpy(), np.stack([want, 0.5 * want]), rtol=1e-9)
 
 
 def test_band_radiance_matches_scipy_quad_with_a_tabulated_response():
