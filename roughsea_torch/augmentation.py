@@ -364,7 +364,7 @@ class RandomSeaBackground(IntensityAugmentationBase2D):
         if self.output == "sensor":
             seeds = sub["noise_seed"].tolist()
             L = torch.cat([
-                self.sensor(L[i : i + 1], generator=torch.Generator(device=L.device).manual_seed(int(s)))
+                self.sensor(L[i : i + 1], generator=torch.Generator().manual_seed(int(s)))
                 for i, s in enumerate(seeds)
             ])
         elif self.output == "brightness_temperature":
