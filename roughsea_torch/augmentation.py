@@ -358,9 +358,10 @@ class RandomSeaBackground(IntensityAugmentationBase2D):
         if self.mode == "composite":
             target = input[idx, :1].to(dtype)
             alpha = input[idx, 1:2].to(dtype).clamp(0.0, 1.0)
-            if self.target_unit == "temperature":
-                target = band_radiance(torch.where(alpha > 0, target, torch.full_like(target, 300.0)), self.band)
-            L = torch.lerp(L, target, alpha)
+            covered = alpha > 0
+            if self.target_unit == "temperature":  # Planck only where a target shows (a band sum per pixel)
+                target = torch.zeros_like(L).index_put((covered,), band_radiance(target[covered], self.band))
+            L = torch.where(covered, torch.lerp(L, target, alpha), L)
         if self.output == "sensor":
             seeds = sub["noise_seed"].tolist()
             L = torch.cat([
