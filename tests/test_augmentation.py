@@ -202,3 +202,20 @@ def test_sensor_output_replays_with_its_noise():
     z = aug(x, params=params)
     d = (z[0] - z[1]).float()
     assert float(d.abs().max()) > 0 and abs(float(d.mean())) < 3.0 * float(d.std()) / d.numel() ** 0.5 + 1.0
+
+
+@pytest.mark.skipif(not torch.cuda.is_available(), reason="needs CUDA")
+def test_cuda_matches_cpu():
+    """Parameters are drawn on the CPU, so a seed gives the same scenes on CUDA; the images agree
+    to float32 rounding of the model (sensor noise too: it is drawn on the CPU per image)."""
+    from roughsea_torch.sensor import SensorModel
+
+    aug = RandomSeaBackground(output="brightness_temperature")
+    x = torch.zeros(2, 1, H, W)
+    a = aug(x, generator=torch.Generator().manual_seed(0))
+    b = aug.to("cuda")(x.cuda(), generator=torch.Generator().manual_seed(0))
+    torch.testing.assert_close(b.cpu(), a, rtol=0, atol=2e-3)  # kelvin
+    s = RandomSeaBackground(sensor=SensorModel.typical_lwir())
+    c = s(x, generator=torch.Generator().manual_seed(1))
+    d = s.to("cuda")(x.cuda(), generator=torch.Generator().manual_seed(1))
+    assert float((d.cpu() - c).abs().max()) <= 2.0  # counts: rounding of nearly equal radiances
