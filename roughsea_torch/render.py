@@ -226,6 +226,10 @@ class TableSize:
     Args:
         zenith: nodes in ζ = asinh(cos θ̂/ε).
         azimuth: nodes in relative azimuth (anisotropic slopes only).
+        azimuth_thin: nodes in relative azimuth when some image's slope ellipse is thin (minor/major
+            rms slope < 0.2: Cox–Munk below ~0.04 m/s, |r| near 1): R_a then changes sharply with
+            azimuth at grazing views (views along the wind at W = 0: 2e-4 with 9 nodes, 1.5e-6 with
+            33, ``pipelines/accuracy_pareto.py``).
         fine_zenith, fine_azimuth: rows/columns of the fine table read by ``grid_sample``.
         span: ``"pixels"`` (default): nodes only over the angles the image's sea pixels span;
             ``"full"``: over every angle (θ̂ in [0°, 90°], every azimuth), for comparison.
@@ -233,6 +237,7 @@ class TableSize:
 
     zenith: int = 25
     azimuth: int = 9
+    azimuth_thin: int = 33
     fine_zenith: int = 4096
     fine_azimuth: int = 128
     span: str = "pixels"
@@ -240,7 +245,7 @@ class TableSize:
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):
             raise ValueError(f"TableSize.span must be 'pixels' or 'full'; got {self.span!r}")
-        for name in ("zenith", "azimuth", "fine_zenith", "fine_azimuth"):
+        for name in ("zenith", "azimuth", "azimuth_thin", "fine_zenith", "fine_azimuth"):
             if int(getattr(self, name)) < 2:
                 raise ValueError(f"TableSize.{name} must be >= 2")
 
@@ -323,6 +328,13 @@ def _azimuth_offsets(
     c = 0.5 * torch.atan2(torch.where(m, torch.sin(2 * ps), zero).sum((1, 2)), torch.where(m, torch.cos(2 * ps), zero).sum((1, 2)))
     k = (math.pi / 2 - c - wind_direction)[:, None, None]
     return c, torch.remainder(torch.atan2(-dy, -dx) + k, math.pi)
+
+
+def _azimuth_folded(dx: torch.Tensor, dy: torch.Tensor, wind_direction: torch.Tensor) -> torch.Tensor:
+    """Per pixel ψ = |wrap(φ̂)| ∈ [0, π/2], φ̂ = atan2(−dy, −dx) − wind direction wrapped to
+    [−π/2, π/2) (period π): the relative azimuth folded by the mirror symmetry of uncorrelated slopes."""
+    k = (math.pi / 2 - wind_direction)[:, None, None]
+    return (torch.remainder(torch.atan2(-dy, -dx) + k, math.pi) - math.pi / 2).abs()
 
 
 def render(
@@ -470,11 +482,19 @@ def _render_table(
     coordinates (and sky radiance, where sky is seen) and the per-image angle ranges; the model is
     evaluated once for the batch; pass 2 samples the tables chunk by chunk. Returns (B, H, W)."""
     iso = bool(((p["vx"] == p["vy"]) & (p["cxy"] == 0)).all())
+    # Uncorrelated anisotropic slopes (Cox–Munk): the table runs over the folded azimuth ψ ∈ [0, π/2].
+    # R_a is even in φ̂ there, and as a → 0 (or b → 0) it has a kink at φ̂ = 0 (π/2), where the
+    # rms slope along the view, √(a² cos²φ̂ + b² sin²φ̂), → b |sin φ̂|: folded, the kink sits at an
+    # end of the node interval instead of inside it, where Chebyshev nodes cannot resolve it
+    # (views along the wind at W = 0 were off by 8e-4 with 9 nodes; pipelines/accuracy_pareto.py).
+    fold = not iso and bool((p["cxy"] == 0).all())
     # ε: a quarter of the smallest rms slope of each image, so ζ resolves the grazing layer.
     lam_min = 0.5 * (p["vx"] + p["vy"] - torch.sqrt((p["vx"] - p["vy"]) ** 2 + 4 * p["cxy"] ** 2))
     eps = (0.25 * torch.sqrt(lam_min.detach().clamp_min(0.0))).clamp(1e-4, 0.05).double()
     inv_eps = (1.0 / eps).to(dtype)
-    nz, nphi = table.zenith, (1 if iso else table.azimuth)
+    lam_max = 0.5 * (p["vx"] + p["vy"] + torch.sqrt((p["vx"] - p["vy"]) ** 2 + 4 * p["cxy"] ** 2))
+    thin = bool((lam_min.detach() < 0.04 * lam_max.detach()).any())  # minor/major rms slope < 0.2
+    nz, nphi = table.zenith, (1 if iso else max(table.azimuth, table.azimuth_thin) if thin else table.azimuth)
     xz, Lz, ez = _lobatto_interp(nz, table.fine_zenith)
     xp, Lp, ep = _lobatto_interp(nphi, 1 if iso else table.fine_azimuth)
     chunks = []
@@ -490,7 +510,14 @@ def _render_table(
         zlo.append(lo)
         zhi.append(hi)
         entry: dict[str, Any] = {"sl": sl, "sea": sea, "zeta": zeta, "sky": None, "range": px.get("range")}
-        if not iso:
+        if fold:  # o = ψ = |φ̂| folded into [0, π/2]: R_a(φ̂) = R_a(−φ̂) = R_a(π − φ̂) when r = 0
+            o = _azimuth_folded(px["dx"], px["dy"], p["wind_direction"][sl])
+            a, b = _masked_range(o, sea)
+            centre.append(torch.zeros_like(a))
+            olo.append(a)
+            ohi.append(b)
+            entry["o"] = o
+        elif not iso:
             c, o = _azimuth_offsets(px["dx"], px["dy"], p["wind_direction"][sl], sea)  # o ∈ [0, π): offset + π/2
             a, b = _masked_range(o, sea)
             centre.append(c)
@@ -524,12 +551,15 @@ def _render_table(
         a = torch.where(any_sea, torch.cat(olo), torch.zeros(B, dtype=dtype, device=device)).double()
         b = torch.where(any_sea, torch.cat(ohi), torch.ones(B, dtype=dtype, device=device)).double()
         if table.span == "full":
-            a, b = torch.zeros_like(a), torch.full_like(b, math.pi)
+            a, b = torch.zeros_like(a), torch.full_like(b, math.pi / 2 if fold else math.pi)
         pad = torch.clamp(1e-6 * (b - a), min=1e-6)
         a, b = a - pad, b + pad
+        if fold:  # ψ ∈ [0, π/2]: keep the nodes inside it (the kink stays at the interval's end)
+            a, b = a.clamp_min(0.0), b.clamp_max(math.pi / 2)
         xp_t = torch.as_tensor(xp, dtype=torch.float64, device=device)
-        # the pixels' o = wrap_π(φ̂ − c) + π/2: nodes at φ̂ = c + o − π/2
-        ph_nodes = (c[:, None] - math.pi / 2 + a[:, None] + (b - a)[:, None] * (xp_t + 1) / 2).to(dtype)
+        # the pixels' o = wrap_π(φ̂ − c) + π/2: nodes at φ̂ = c + o − π/2 (folded: φ̂ = o = ψ)
+        shift = 0.0 if fold else math.pi / 2
+        ph_nodes = (c[:, None] - shift + a[:, None] + (b - a)[:, None] * (xp_t + 1) / 2).to(dtype)
     vz = th_nodes[:, :, None].expand(B, nz, nphi)
     va = ph_nodes[:, None, :].expand(B, nz, nphi)
     slopes = SlopeStatistics.from_variances(p["vx"][:, None, None], p["vy"][:, None, None], p["cxy"][:, None, None])
