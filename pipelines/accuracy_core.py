@@ -27,14 +27,10 @@ from tqdm import tqdm
 
 import roughsea_torch as rs
 import roughsea_torch.reference as ref
-from roughsea_torch.expectation import Quadrature
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from _common import CONVERGED, sky  # noqa: E402
 from test_agreement import CASES, M, case_inputs, make_slopes  # noqa: E402
-
-
-def sky(c):
-    return 11.0 + 19.0 * (1.0 - c) ** 8
 
 
 def main() -> None:
@@ -67,7 +63,7 @@ def main() -> None:
     laws = [("cm", w, an) for w in (0, 2, 5, 10, 20, 40) for an in (False, True)]
     laws += [("iso", 1e-6), ("iso", 1e-4), ("abr", 0.3, 0.03, 0.0), ("abr", 0.2, 0.1, 0.9), ("abr", 0.05, 0.15, -0.9),
              ("abr", 0.3, 0.03, 0.9), ("abr", 0.4, 0.04, -0.9)]
-    conv = Quadrature(outer=64, inner=64, hermite=32, width=9.5)
+    conv = CONVERGED
     sweep = {torch.float64: [0.0, 0.0], torch.float32: [0.0, 0.0]}
     for spec in tqdm(laws, desc="sweep"):
         for sh in (True, False):

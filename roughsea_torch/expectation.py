@@ -82,7 +82,10 @@ class Quadrature:
 
     ``Quadrature.default(dtype)`` is what every function uses when ``quadrature=None``; it meets
     a relative error of 1e-6 in float64 and 1e-5 in float32 against a converged reference over
-    the model's range (see ``pipelines/accuracy.py``).
+    the model's range with a smooth sky (``pipelines/accuracy_core.py``); error against run time
+    of every setting, and where it sits on the Pareto front: ``pipelines/accuracy_pareto.py``;
+    the extremes, and the regimes where the default does worse (a tabulated sky's C¹ kinks, a
+    sky far colder than the sea at grazing): ``pipelines/stability.py``.
     """
 
     outer: int = 28
@@ -136,6 +139,17 @@ def _Phi(x: torch.Tensor) -> torch.Tensor:
     return 0.5 * torch.erfc(-x * _SQRT_HALF)
 
 
+def _asin2(x: torch.Tensor) -> torch.Tensor:
+    """2 asin(x) with x clamped to [−1, 1] and a zero (not NaN) gradient where |x| ≥ 1.
+
+    ``asin(x.clamp(-1, 1))`` passes the gradient through at |x| = 1 exactly, where asin' = ∞, and
+    0 · ∞ = NaN reached the inputs' gradients (float32, a = 0 viewed crosswind near grazing).
+    """
+    inside = x.abs() < 1.0
+    safe = torch.where(inside, x, torch.zeros_like(x))
+    return torch.where(inside, 2.0 * torch.asin(safe), math.pi * torch.sign(x))
+
+
 # -- per-evaluation geometry -----------------------------------------------------------------
 
 
@@ -155,8 +169,14 @@ class _Geom:
 
 
 def _floors(dtype: torch.dtype) -> tuple[float, float]:
-    """(smallest cos θ̂ used, smallest rms slope used); both far below any physical effect."""
-    return (1e-7, 1e-12) if dtype == torch.float32 else (1e-12, 1e-12)
+    """(smallest cos θ̂ used, smallest rms slope used); both far below any physical effect.
+
+    The same in every dtype, so that float32 and float64 agree at the same (float32-held) input:
+    float32(π/2) lies above π/2, and a larger float32 floor (it was 1e-7) made the float32 value
+    there, and at the float32 angle below it (cos θ̂ = 7.5e-8), differ from float64's by up to 30 %
+    on a calm sea, where ε̄ ∝ cos θ̂ (``pipelines/stability.py``, ``tests/test_stability.py``).
+    """
+    return 1e-12, 1e-12
 
 
 def _geometry(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor) -> _Geom:
@@ -246,7 +266,7 @@ def _sky_numerator(
         d = 0.5 * u * ct
         A = torch.sqrt((B * B + d).clamp_min(tiny))
         C = torch.sqrt((1.0 - B * B - d).clamp_min(tiny))
-        return 2.0 * torch.asin((d / (A * sqrt_1mB2 + B * C)).clamp(-1.0, 1.0))
+        return _asin2(d / (A * sqrt_1mB2 + B * C))
 
     u_far = (1.0 + st) / ct
     u_lo = torch.maximum(-alpha, -K * su)
@@ -464,22 +484,30 @@ def emissivity(
     n, k = split_refractive_index(refractive_index, dtype, device)
     q = quadrature or Quadrature.default(dtype)
     shape = torch.broadcast_shapes(vz.shape, va.shape, vx.shape, vy.shape, cxy.shape, n.shape, k.shape)
+    work = _work_dtype(dtype, shadowing)
+    vz, va, vx, vy, cxy, n, k = (t.to(work) for t in (vz, va, vx, vy, cxy, n, k))
     g = _geometry(vz, va, vx, vy, cxy).flat(shape)
     D = _denominator(g, shadowing)
     nf, kf = n.expand(shape).reshape(-1), k.expand(shape).reshape(-1)
     points = q.outer * q.hermite * (1 if shadowing else 2)
 
-    # Without shadowing, Eq. 7 cancels the negative projected area of facets turned away against
-    # the positive one: near grazing the result is ~cos θ̂ while each part is ~σ∥, a condition
-    # number ~σ∥ tan θ̂ (10³ at 89.99°). Those sums are accumulated in float64 whatever the dtype.
-    work = torch.float64 if not shadowing else dtype
-    gw = _Geom(*(t.to(work) for t in (g.ct, g.st, g.su, g.kappa, g.tau)))
-    nw, kw, Dw = nf.to(work), kf.to(work), D.to(work)
-
     def one(sl: slice) -> torch.Tensor:
-        return (_emissivity_numerator(gw.take(sl), nw[sl], kw[sl], shadowing, q) / Dw[sl]).to(dtype)
+        return (_emissivity_numerator(g.take(sl), nf[sl], kf[sl], shadowing, q) / D[sl]).to(dtype)
 
     return _run_chunked(shape, points, q, one, dtype, device)
+
+
+def _work_dtype(dtype: torch.dtype, shadowing: bool) -> torch.dtype:
+    """The dtype the integrals are accumulated in.
+
+    Without shadowing, Eq. 7 cancels the negative projected area of facets turned away against the
+    positive one: near grazing ε̄ ~ cos θ̂ while each part is ~σ∥, a condition number ~σ∥ tan θ̂
+    (10³ at 89.99°); and R_a = R_B (1 − T_ρ) + T_s with T_ρ, T_s/R_B ~ σ∥/cos θ̂ ≫ 1 cancel to
+    R_B + O(1). Both are computed in float64 whatever the dtype, and the result is rounded once
+    (in float32 they reached 1e-4 at θ̂ ≥ 89.9999°, ``pipelines/stability.py``). With shadowing
+    (T_ρ ≤ 1, ε̄ a mean of positive terms) the dtype itself is used.
+    """
+    return torch.float64 if not shadowing else dtype
 
 
 def apparent_radiance(
@@ -520,11 +548,11 @@ def apparent_radiance(
         directions each) and must act elementwise.
     """
     check_finite_range("sea_radiance", sea_radiance, 0.0, unit="W m-2 sr-1")
-    t_s, t_rho = reflection_terms(
-        view_zenith, view_azimuth, slopes, refractive_index, sky, shadowing, quadrature, _extra=dict(sea_radiance=sea_radiance)
+    t_s, t_rho, dtype = _reflection_terms(
+        view_zenith, view_azimuth, slopes, refractive_index, sky, shadowing, quadrature, dict(sea_radiance=sea_radiance)
     )
-    rb = as_tensor(sea_radiance, t_s.dtype, t_s.device)
-    return rb - rb * t_rho + t_s
+    rb = as_tensor(sea_radiance, dtype, t_s.device).to(t_s.dtype)
+    return (rb - rb * t_rho + t_s).to(dtype)
 
 
 def reflection_terms(
@@ -543,7 +571,25 @@ def reflection_terms(
     ray reaches the sky (the others see the sea, R_B). T_ρ is dimensionless; T_s has the units of
     the sky radiance. Both are independent of the sea temperature, so a renderer can tabulate them
     once per sea state and apply R_B per pixel. Arguments as :func:`apparent_radiance`.
+
+    Without shadowing T_ρ and T_s/R_B grow like σ∥/cos θ̂ near grazing and R_B (1 − T_ρ) + T_s
+    cancels them: combine them in float64 there (``apparent_radiance`` does).
     """
+    t_s, t_rho, dtype = _reflection_terms(view_zenith, view_azimuth, slopes, refractive_index, sky, shadowing, quadrature, _extra)
+    return t_s.to(dtype), t_rho.to(dtype)
+
+
+def _reflection_terms(
+    view_zenith: Any,
+    view_azimuth: Any,
+    slopes: SlopeStatistics,
+    refractive_index: Any,
+    sky: Any,
+    shadowing: bool,
+    quadrature: Quadrature | None,
+    _extra: dict | None,
+) -> tuple[torch.Tensor, torch.Tensor, torch.dtype]:
+    """(T_s, T_ρ) in the working dtype (:func:`_work_dtype`), and the call's dtype."""
     sky_fn = as_sky(sky)
     sky_tensor = sky_fn.radiance if isinstance(sky_fn, (TabulatedSky, ConstantSky)) else None
     extra = {k: v for k, v in (_extra or {}).items() if isinstance(v, torch.Tensor)}
@@ -555,11 +601,13 @@ def reflection_terms(
     shape = torch.broadcast_shapes(
         vz.shape, va.shape, vx.shape, vy.shape, cxy.shape, n.shape, k.shape, _sky_batch_shape(sky_fn)
     )
+    work = _work_dtype(dtype, shadowing)
+    vz, va, vx, vy, cxy, n, k = (t.to(work) for t in (vz, va, vx, vy, cxy, n, k))
     g = _geometry(vz, va, vx, vy, cxy).flat(shape)
     if g.ct.numel() == 0:
-        z = torch.zeros(shape, dtype=dtype, device=device)
-        return z, z
+        z = torch.zeros(shape, dtype=work, device=device)
+        return z, z, dtype
     D = _denominator(g, shadowing)
     nf, kf = n.expand(shape).reshape(-1), k.expand(shape).reshape(-1)
     t_s, t_rho = _sky_terms(g, nf, kf, sky_fn, shape, D, q)
-    return t_s.reshape(shape), t_rho.reshape(shape)
+    return t_s.reshape(shape), t_rho.reshape(shape), dtype

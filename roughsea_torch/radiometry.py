@@ -6,6 +6,7 @@ W m⁻² sr⁻¹ m⁻¹, band radiance in W m⁻² sr⁻¹. Constants are the ex
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -55,19 +56,19 @@ def planck_radiance(wavelength: Any, temperature: Any) -> torch.Tensor:
 
 
 def _planck(lam: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
-    # Scale to micrometres inside so float32 never sees λ⁻⁵ ~ 1e30.
+    # Scale to micrometres inside so float32 never sees λ⁻⁵ ~ 1e30. Written with e^{−x} so that a
+    # cold body (x = hc/λkT beyond the exponent range: 10 K in float32) gives B = 0 and a zero
+    # gradient, where 1/expm1(x) = 1/∞ had a NaN gradient (∞/∞); ``pipelines/stability.py``.
     lam_um = lam * 1e6
     x = (_C2 * 1e6) / (lam_um * t)
-    return (_C1 * 1e24 * 1e6) / (lam_um**5 * torch.expm1(x))
+    return (_C1 * 1e24 * 1e6) * torch.exp(-x) / (lam_um**5 * -torch.expm1(-x))
 
 
 def _planck_dT(lam: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
-    """∂B_λ/∂T [W m⁻² sr⁻¹ m⁻¹ K⁻¹]."""
+    """∂B_λ/∂T = B_λ · x / (T (1 − e^{−x})) [W m⁻² sr⁻¹ m⁻¹ K⁻¹]; 0 (not NaN) where B_λ underflows."""
     lam_um = lam * 1e6
     x = (_C2 * 1e6) / (lam_um * t)
-    em1 = torch.expm1(x)
-    b = (_C1 * 1e24 * 1e6) / (lam_um**5 * em1)
-    return b * x / t * (em1 + 1.0) / em1
+    return _planck(lam, t) * x / (t * -torch.expm1(-x))
 
 
 @dataclass(frozen=True)
@@ -190,36 +191,51 @@ def band_radiance(temperature: Any, band: Any = LWIR, response: Any = None) -> t
     return (_planck(lam, t.unsqueeze(-1)) * w).sum(-1)
 
 
+def _log_band_radiance(lam: torch.Tensor, w: torch.Tensor, t: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """(log L(T), d log L / dT) of the band radiance L = Σ wᵢ B_λᵢ(T), in log space (float64 inputs).
+
+    Finite for every T > 0 and every L a float can hold: at a few kelvin B underflows even float64
+    (e^{−x}, x ~ 700), while its logarithm and the softmax-weighted slope do not.
+    """
+    lam_um = lam * 1e6
+    x = (_C2 * 1e6) / (lam_um * t.unsqueeze(-1))
+    one_m = -torch.expm1(-x)  # 1 − e^{−x}
+    log_b = math.log(_C1 * 1e30) - 5.0 * torch.log(lam_um) - x - torch.log(one_m)
+    a = torch.log(w) + log_b
+    p = torch.softmax(a, -1)
+    return torch.logsumexp(a, -1), (p * x / one_m).sum(-1) / t
+
+
 class _BrightnessTemperature(torch.autograd.Function):
-    """Inverse of the band radiance by Newton iterations (float64); backward by the implicit-function
-    theorem dT/dL = 1/(dL/dT). Used outside the tabulated 100–500 K range."""
+    """Inverse of the band radiance by Newton iterations on log L (float64); backward by the
+    implicit-function theorem dT/dL = 1/(L · d log L/dT). Used outside the tabulated 100–500 K range.
+
+    In log space both stay finite down to the smallest positive radiance (the direct form's dL/dT
+    underflowed to 0 there: NaN temperatures in float64, infinite gradients in float32).
+    """
 
     @staticmethod
     def forward(ctx, radiance, lam, w):  # type: ignore[override]
-        L = radiance.double()
-        lam64, w64 = lam.double(), w.double()
+        log_l = torch.log(radiance.double())
+        lam64, w64 = lam.double(), w.double().clamp_min(1e-300)
         # Initial guess: invert Planck at the response-weighted mean wavelength, then Newton.
-        lam_c = (lam64 * w64).sum() / w64.sum()
-        width = w64.sum()
-        Bc = (L / width).clamp_min(1e-300)
-        lam_um = lam_c * 1e6
-        t = (_C2 * 1e6) / (lam_um * torch.log1p((_C1 * 1e30) / (lam_um**5 * Bc)))
-        for _ in range(50):
-            f = (_planck(lam64, t.unsqueeze(-1)) * w64).sum(-1) - L
-            df = (_planck_dT(lam64, t.unsqueeze(-1)) * w64).sum(-1)
-            step = f / df
-            t = (t - step).clamp_min(1.0)
+        lam_um = float((lam64 * w64).sum() / w64.sum()) * 1e6
+        log_arg = math.log(_C1 * 1e30) - 5.0 * math.log(lam_um) - (log_l - math.log(float(w64.sum())))
+        t = (_C2 * 1e6) / (lam_um * torch.logaddexp(torch.zeros_like(log_arg), log_arg))  # log1p(e^{log_arg})
+        for _ in range(60):
+            f, df = _log_band_radiance(lam64, w64, t)
+            step = (f - log_l) / df
+            t = torch.maximum(t - step, 0.5 * t)
             if bool((step.abs() <= 1e-13 * t).all()):
                 break
-        t = t.to(radiance.dtype)
-        ctx.save_for_backward(t, lam, w)
-        return t
+        ctx.save_for_backward(t, log_l, lam64, w64)
+        return t.to(radiance.dtype)
 
     @staticmethod
     def backward(ctx, grad):  # type: ignore[override]
-        t, lam, w = ctx.saved_tensors
-        dLdT = (_planck_dT(lam, t.unsqueeze(-1)) * w).sum(-1)
-        return grad / dLdT, None, None
+        t, log_l, lam64, w64 = ctx.saved_tensors
+        _, dlog = _log_band_radiance(lam64, w64, t)
+        return (grad.double() / (torch.exp(log_l) * dlog)).to(grad.dtype), None, None
 
 
 _T_LO, _T_HI, _T_STEP = 100.0, 500.0, 0.25
@@ -227,15 +243,26 @@ _bt_cache: dict[tuple, tuple[torch.Tensor, ...]] = {}
 
 
 def _bt_table(band: SpectralBand, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, ...]:
-    """Band radiance L(T) and dL/dT on a 0.25 K grid over 100–500 K (float64 nodes, cached)."""
+    """Band radiance nodes L(T) on a 0.25 K grid over 100–500 K and, per interval, 1/ΔL and the
+    power-form coefficients of the cubic Hermite T(L) in t = (L − L_i)/ΔL (float64, then cast).
+
+    The power form with coefficients made in float64 keeps float32 gradients dT/dL accurate: the
+    Hermite basis form (2t³ − 3t² + 1) T_i + … − … T_{i+1} differentiated in float32 cancels
+    terms ~T/ΔT = 10³ times larger than the result (4e-4 relative, ``pipelines/stability.py``).
+    """
     key = (hash(band), dtype, device)
     hit = _bt_cache.get(key)
     if hit is None:
         lam, w = (torch.as_tensor(a, dtype=torch.float64) for a in band.quadrature)
         T = torch.arange(_T_LO, _T_HI + _T_STEP / 2, _T_STEP, dtype=torch.float64)
         L = (_planck(lam, T[:, None]) * w).sum(-1)
-        dL = (_planck_dT(lam, T[:, None]) * w).sum(-1)
-        hit = tuple(t.to(device=device, dtype=dtype) for t in (T, L, dL))
+        m = 1.0 / (_planck_dT(lam, T[:, None]) * w).sum(-1)  # dT/dL at the nodes
+        h = L[1:] - L[:-1]
+        dT = T[1:] - T[:-1]
+        c1 = h * m[:-1]
+        c2 = 3.0 * dT - h * (2.0 * m[:-1] + m[1:])
+        c3 = -2.0 * dT + h * (m[:-1] + m[1:])
+        hit = tuple(t.to(device=device, dtype=dtype) for t in (L, 1.0 / h, T[:-1], c1, c2, c3))
         _bt_cache[key] = hit
     return hit
 
@@ -251,19 +278,11 @@ def brightness_temperature(radiance: Any, band: Any = LWIR, response: Any = None
     b = as_band(band, response)
     dtype, device = resolve_dtype_device(radiance=radiance)
     L = as_tensor(radiance, dtype, device)
-    T, Ln, dL = _bt_table(b, dtype, device)
+    Ln, inv_h, c0, c1, c2, c3 = _bt_table(b, dtype, device)
     inside = (L >= Ln[0]) & (L <= Ln[-1])
     i = torch.searchsorted(Ln, L.detach().contiguous()).clamp(1, Ln.numel() - 1) - 1
-    x0, x1 = Ln[i], Ln[i + 1]
-    h = x1 - x0
-    t = (L - x0) / h
-    t2, t3 = t * t, t * t * t
-    out = (
-        (2 * t3 - 3 * t2 + 1) * T[i]
-        + (t3 - 2 * t2 + t) * h / dL[i]
-        + (-2 * t3 + 3 * t2) * T[i + 1]
-        + (t3 - t2) * h / dL[i + 1]
-    )
+    t = (L - Ln[i]) * inv_h[i]
+    out = c0[i] + t * (c1[i] + t * (c2[i] + t * c3[i]))
     if not bool(inside.all()):
         lam, w = b.nodes(dtype, device)
         far = _BrightnessTemperature.apply(L, lam, w)
