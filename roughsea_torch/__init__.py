@@ -45,6 +45,10 @@ from .sensor import SensorModel
 __version__ = "0.1.0"
 
 __all__ = [
+    "atmosphere",
+    "augmentation",
+    "dataset",
+    "sensor",
     "EARTH_RADIUS_M",
     "LWIR",
     "MWIR",

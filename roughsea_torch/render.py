@@ -33,7 +33,7 @@ import torch.nn.functional as F
 from kornia.geometry.camera import PinholeCamera
 
 from ._validation import check_finite_range, per_batch
-from .expectation import Quadrature, apparent_radiance, reflection_terms
+from .expectation import Quadrature, _reflection_terms, apparent_radiance
 from .geometry import EARTH_RADIUS_M, CameraGeometry, ViewGeometry, view_geometry
 from .optics import band_refractive_index, split_refractive_index
 from .radiometry import LWIR, SpectralBand, as_band, band_radiance, brightness_temperature
@@ -564,11 +564,13 @@ def _render_table(
     va = ph_nodes[:, None, :].expand(B, nz, nphi)
     slopes = SlopeStatistics.from_variances(p["vx"][:, None, None], p["vy"][:, None, None], p["cxy"][:, None, None])
     sky = _sky_per_image(p["sky"], B, dtype, device, 2)
-    t_s, t_rho = reflection_terms(vz, va, slopes, (p["n"][:, None, None], p["k"][:, None, None]), sky, scene.shadowing, q)
+    # T_s, T_ρ in the model's working dtype: float64 without shadowing, where they grow like
+    # σ∥/cos θ̂ and R_B (1 − T_ρ) + T_s cancels them (expectation._work_dtype)
+    t_s, t_rho, _ = _reflection_terms(vz, va, slopes, (p["n"][:, None, None], p["k"][:, None, None]), sky, scene.shadowing, q, None)
     if p["air_scale"] is not None:
-        t_s = t_s * p["air_scale"][:, None, None]
-    rb = p["rb"][:, None, None]
-    coarse = rb - rb * t_rho + t_s  # R_a at the nodes (B, nz, nphi); linear in the node values
+        t_s = t_s * p["air_scale"][:, None, None].to(t_s.dtype)
+    rb = p["rb"][:, None, None].to(t_s.dtype)
+    coarse = (rb - rb * t_rho + t_s).to(dtype)  # R_a at the nodes (B, nz, nphi); linear in the node values
     Lz_t = torch.as_tensor(Lz, dtype=dtype, device=device)
     Lp_t = torch.as_tensor(Lp, dtype=dtype, device=device)
     # the fine table (Mz × Mp per image) is made per chunk in pass 2, not for the whole batch
