@@ -229,7 +229,7 @@ class TableSize:
         azimuth_thin: nodes in relative azimuth when some image's slope ellipse is thin (minor/major
             rms slope < 0.2: Cox–Munk below ~0.04 m/s, |r| near 1): R_a then changes sharply with
             azimuth at grazing views (views along the wind at W = 0: 2e-4 with 9 nodes, 1.5e-6 with
-            33, ``pipelines/accuracy_pareto.py``).
+            33, folded; ``tests/test_render.py``).
         fine_zenith, fine_azimuth: rows/columns of the fine table read by ``grid_sample``.
         span: ``"pixels"`` (default): nodes only over the angles the image's sea pixels span;
             ``"full"``: over every angle (θ̂ in [0°, 90°], every azimuth), for comparison.
@@ -237,10 +237,10 @@ class TableSize:
 
     zenith: int = 25
     azimuth: int = 9
-    azimuth_thin: int = 33
     fine_zenith: int = 4096
     fine_azimuth: int = 128
     span: str = "pixels"
+    azimuth_thin: int = 33
 
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):
