@@ -127,7 +127,7 @@ def train(steps: int, batch: int, height: int, width: int, seed: int, log=print)
         t2 = time.perf_counter()
         t_aug.append(t1 - t0)
         t_net.append(t2 - t1)
-        losses.append(float(loss))
+        losses.append(float(loss.detach()))
         ious.append(iou(logits.detach(), mask))
         if batch0 is None:
             batch0 = (x[:, :1].clone(), mask.clone(), dict(aug._params))
