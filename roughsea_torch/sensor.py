@@ -588,6 +588,15 @@ class ToCounts(nn.Module):
 # display
 
 
+def _check_display_args(low_percentile: Any, high_percentile: Any, output_dtype: Any) -> None:
+    check_finite_range("low_percentile", low_percentile, 0.0, 100.0, unit="%")
+    check_finite_range("high_percentile", high_percentile, 0.0, 100.0, unit="%")
+    if not float(low_percentile) < float(high_percentile):
+        raise ValueError(f"low_percentile must be below high_percentile; got {low_percentile} and {high_percentile}")
+    if output_dtype not in (None, torch.uint8):
+        raise ValueError(f"output_dtype must be None or torch.uint8; got {output_dtype}")
+
+
 def to_display(image: torch.Tensor, low_percentile: float = 1.0, high_percentile: float = 99.0,
                output_dtype: torch.dtype | None = None) -> torch.Tensor:
     """Per-image percentile stretch to 8-bit display values.
@@ -607,12 +616,7 @@ def to_display(image: torch.Tensor, low_percentile: float = 1.0, high_percentile
         and 255 above.
     """
     image = _check_image("image", image, allow_integer=True)
-    check_finite_range("low_percentile", low_percentile, 0.0, 100.0, unit="%")
-    check_finite_range("high_percentile", high_percentile, 0.0, 100.0, unit="%")
-    if not float(low_percentile) < float(high_percentile):
-        raise ValueError(f"low_percentile must be below high_percentile; got {low_percentile} and {high_percentile}")
-    if output_dtype not in (None, torch.uint8):
-        raise ValueError(f"output_dtype must be None or torch.uint8; got {output_dtype}")
+    _check_display_args(low_percentile, high_percentile, output_dtype)
     B = image.shape[0]
     if image.numel() == 0:
         return image.clone() if output_dtype is None else image.to(output_dtype)
@@ -639,12 +643,7 @@ class ToDisplay(nn.Module):
     def __init__(self, low_percentile: float = 1.0, high_percentile: float = 99.0,
                  output_dtype: torch.dtype | None = None) -> None:
         super().__init__()
-        check_finite_range("low_percentile", low_percentile, 0.0, 100.0, unit="%")
-        check_finite_range("high_percentile", high_percentile, 0.0, 100.0, unit="%")
-        if not float(low_percentile) < float(high_percentile):
-            raise ValueError(f"low_percentile must be below high_percentile; got {low_percentile} and {high_percentile}")
-        if output_dtype not in (None, torch.uint8):
-            raise ValueError(f"output_dtype must be None or torch.uint8; got {output_dtype}")
+        _check_display_args(low_percentile, high_percentile, output_dtype)
         self.low_percentile = float(low_percentile)
         self.high_percentile = float(high_percentile)
         self.output_dtype = output_dtype
