@@ -93,7 +93,10 @@ def test_p_gates_images_and_skips_their_rendering():
     gate = aug._params["batch_prob"] > 0.5
     assert 0 < int(gate.sum()) < 8
     assert bool((y[~gate] == -1.0).all())
-    assert bool((y[gate] > 200.0).all())
+    # each selected image is the render of its own parameter row
+    own = {k: v[gate] for k, v in aug._params.items() if v.ndim == 1 and v.shape[0] == 8}
+    want = rs.brightness_temperature(render_parameters(own, H, W, aug.sampler.atmospheres), rs.LWIR)
+    torch.testing.assert_close(y[gate], want, rtol=0, atol=1e-4)
     assert torch.equal(small(p=0.0)(x), x)
 
 
@@ -106,6 +109,7 @@ def test_inside_augmentation_sequential_with_masks_and_boxes():
     boxes = torch.tensor([[[2.0, 5.0, 6.0, 9.0]]]).repeat(2, 1, 1)
     torch.manual_seed(0)
     y, m2, b2 = seq(x, m, boxes)
+    assert bool((y > 200.0).all())  # the sea was rendered inside the container
     # the sea is rendered, then flipped; masks and boxes move with the flip only
     assert torch.equal(m2, m.flip(-1))
     assert torch.allclose(b2[..., 0], W - 1 - boxes[..., 2]) and torch.allclose(b2[..., 2], W - 1 - boxes[..., 0])  # kornia: x -> W - 1 - x
@@ -116,10 +120,12 @@ def test_inside_augmentation_sequential_with_masks_and_boxes():
 def test_rendering_matches_an_explicit_scene():
     """The parameters reach the renderer in the documented units (wind direction in degrees,
     per-image atmospheres): a mixed-atmosphere batch equals each image rendered on its own."""
-    s = SceneSampler(atmospheres=["tropical", "midlatitude_winter"], air_temperature=(270.0, 300.0))
+    s = SceneSampler(atmospheres=["tropical", "midlatitude_winter"], air_temperature=(270.0, 300.0),
+                     yaw_deg=(-180.0, 180.0), pitch_deg=(-25.0, -2.0))
     p = s.sample(4, generator=torch.Generator().manual_seed(9))
     p["atmosphere"] = torch.tensor([0, 1, 0, 1])
     img = render_parameters(p, H, W, s.atmospheres, dtype=torch.float64)
+    no_path = render_parameters(p, H, W, s.atmospheres, dtype=torch.float64, path=False)
     for i in range(4):
         cam = rs.make_camera(H, W, hfov_deg=float(p["hfov_deg"][i]), altitude_m=float(p["altitude_m"][i]),
                              pitch_deg=float(p["pitch_deg"][i]), yaw_deg=float(p["yaw_deg"][i]),
@@ -129,6 +135,9 @@ def test_rendering_matches_an_explicit_scene():
                             sky=s.atmospheres[int(p["atmosphere"][i])])
         ref = rs.render(cam, scene)
         torch.testing.assert_close(img[i : i + 1], ref, rtol=1e-7, atol=0.0)  # batching order only
+        scene.path = None
+        torch.testing.assert_close(no_path[i : i + 1], rs.render(cam, scene), rtol=1e-7, atol=0.0)
+    assert not torch.allclose(img, no_path)
 
 
 @pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
@@ -145,6 +154,11 @@ def test_composite_is_alpha_blending_in_radiance(dtype):
     torch.testing.assert_close(y[:, 0, 8:16], 0.5 * (t + sea[:, 0, 8:16]))
     torch.testing.assert_close(y[:, 0, 16:], sea[:, 0, 16:], rtol=0, atol=0)
     assert torch.equal(y[:, 1], x[:, 1])  # alpha passes through
+    # the same target given as radiance (target_unit="radiance") composites to the same image
+    xr = x.clone()
+    xr[:, 0] = t
+    yr = RandomSeaBackground(mode="composite", output="radiance", target_unit="radiance")(xr, params=aug._params)
+    torch.testing.assert_close(yr, torch.cat([y[:, :1], x[:, 1:]], 1), rtol=1e-6, atol=0)
     # a half-covering 320 K target over a ~290 K sea is warmer than the temperature average:
     # blending happens in radiance, which is convex in temperature
     bt = rs.brightness_temperature(y[:, 0, 8:16], rs.LWIR)
@@ -161,7 +175,12 @@ def test_gradient_to_target_temperature():
     y = aug(x, generator=torch.Generator().manual_seed(0))
     (g,) = torch.autograd.grad(y[:, 0].sum(), x)
     assert torch.isfinite(g).all()
-    assert bool((g[0, 0, 4:8, 4:8] > 0.2).all()) and bool((g[0, 0, 4:8, 4:8] < 1.0).all())
+    # T_out = T_b(α B(T_t) + (1 − α) L_sea): dT_out/dT_t = α B'(T_t) / B'(T_out)
+    t = torch.tensor([310.0], dtype=torch.float64, requires_grad=True)
+    (db_t,) = torch.autograd.grad(rs.band_radiance(t, rs.LWIR).sum(), t)
+    t_out = y[0, 0, 4:8, 4:8].detach().reshape(-1).requires_grad_(True)
+    (db_out,) = torch.autograd.grad(rs.band_radiance(t_out, rs.LWIR).sum(), t_out)
+    torch.testing.assert_close(g[0, 0, 4:8, 4:8].reshape(-1), 0.3 * db_t / db_out, rtol=1e-6, atol=0)
     assert float(g[0, 0, 10:].abs().max()) == 0.0  # α = 0: the target does not show
 
 
