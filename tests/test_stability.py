@@ -66,6 +66,13 @@ def test_gradients_finite_viewing_across_a_one_axis_slope_law(dtype, theta_deg):
     r = rs.apparent_radiance(th, ph, rs.SlopeStatistics.from_variances(vx, vy, 0.0), M, sea_radiance=30.0, sky=smooth_sky)
     grads = torch.autograd.grad(r, (th, ph, vx, vy))
     assert torch.isfinite(r) and all(torch.isfinite(g) for g in grads)
+    # and right, not merely finite: ∂R_a/∂b² against a float64 central difference
+    def f(v: float) -> float:
+        s64 = rs.SlopeStatistics.from_variances(torch.tensor(0.0, dtype=F64), torch.tensor(v, dtype=F64), 0.0)
+        return float(rs.apparent_radiance(torch.tensor(float(th.detach()), dtype=F64), math.pi / 2, s64, M, sea_radiance=30.0, sky=smooth_sky))
+
+    fd = (f(0.01 + 1e-6) - f(0.01 - 1e-6)) / 2e-6
+    assert abs(float(grads[3]) - fd) <= (1e-5 if dtype == F64 else 2e-3) * abs(fd)
 
 
 @pytest.mark.parametrize("var", [(5e-9, 5e-9, 0.0), (5e-7, 5e-7, 0.0), (0.09, 9e-8, 0.0)], ids=["s2=1e-8", "s2=1e-6", "a/b=1000"])
