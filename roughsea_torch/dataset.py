@@ -69,6 +69,12 @@ def _band(name: Any) -> SpectralBand:
     raise ValueError(f"scene.band: 'LWIR', 'MWIR' or [lambda_lo_m, lambda_hi_m]; got {name!r}")
 
 
+def _sampler(scene: dict[str, Any]) -> SceneSampler:
+    """The SceneSampler of a config's ``scene`` table (its ranges; band and renderer switches aside)."""
+    return SceneSampler(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in scene.items()
+                           if k not in ("band", "anisotropic", "path")})
+
+
 def _stage_classes() -> dict[str, type]:
     from . import sensor as S
 
@@ -119,7 +125,7 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
         if not isinstance(sc[key], bool):
             raise ValueError(f"config: scene.{key} must be true or false; got {sc[key]!r}")
     try:
-        SceneSampler(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in sc.items() if k not in ("band", "anisotropic", "path")})
+        _sampler(sc)
     except ValueError as e:
         raise ValueError(f"config: scene.{e}") from None
     sensor = config.get("sensor", {})
@@ -192,7 +198,7 @@ def render_shard(cfg: dict[str, Any], k: int, sensor: torch.nn.Module | None = N
                  device: torch.device | str | None = None) -> dict[str, np.ndarray]:
     """Images [k·S, (k+1)·S) of a resolved config: counts (uint16) and their parameters."""
     sc = cfg["scene"]
-    sampler = SceneSampler(**{n: (tuple(v) if isinstance(v, list) else v) for n, v in sc.items() if n not in ("band", "anisotropic", "path")})
+    sampler = _sampler(sc)
     S, N = cfg["shard_size"], cfg["num_images"]
     indices = list(range(k * S, min((k + 1) * S, N)))
     params = sampler.sample_indexed(cfg["seed"], indices)

@@ -26,6 +26,7 @@ __all__ = [
     "planck_radiance",
     "band_radiance",
     "brightness_temperature",
+    "band_radiance_slope",
 ]
 
 PLANCK_H = 6.62607015e-34  # J s
@@ -267,6 +268,16 @@ def _bt_table(band: SpectralBand, dtype: torch.dtype, device: torch.device) -> t
     return hit
 
 
+def _bt_hermite(L: torch.Tensor, b: SpectralBand) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, tuple[torch.Tensor, ...]]:
+    """The interval i of each radiance in the T(L) table, its local coordinate t, whether it lies
+    inside the table, and the table (:func:`_bt_table`)."""
+    tab = _bt_table(b, L.dtype, L.device)
+    Ln, inv_h = tab[0], tab[1]
+    inside = (L >= Ln[0]) & (L <= Ln[-1])
+    i = torch.searchsorted(Ln, L.detach().contiguous()).clamp(1, Ln.numel() - 1) - 1
+    return i, (L - Ln[i]) * inv_h[i], inside, tab
+
+
 def brightness_temperature(radiance: Any, band: Any = LWIR, response: Any = None) -> torch.Tensor:
     """Temperature [K] of the blackbody whose band radiance equals ``radiance`` [W m⁻² sr⁻¹].
 
@@ -278,15 +289,33 @@ def brightness_temperature(radiance: Any, band: Any = LWIR, response: Any = None
     b = as_band(band, response)
     dtype, device = resolve_dtype_device(radiance=radiance)
     L = as_tensor(radiance, dtype, device)
-    Ln, inv_h, c0, c1, c2, c3 = _bt_table(b, dtype, device)
-    inside = (L >= Ln[0]) & (L <= Ln[-1])
-    i = torch.searchsorted(Ln, L.detach().contiguous()).clamp(1, Ln.numel() - 1) - 1
-    t = (L - Ln[i]) * inv_h[i]
+    i, t, inside, (_, _, c0, c1, c2, c3) = _bt_hermite(L, b)
     out = c0[i] + t * (c1[i] + t * (c2[i] + t * c3[i]))
     if not bool(inside.all()):
         lam, w = b.nodes(dtype, device)
         far = _BrightnessTemperature.apply(L, lam, w)
         out = torch.where(inside, out, far)
+    return out
+
+
+def band_radiance_slope(radiance: Any, band: Any = LWIR, response: Any = None) -> torch.Tensor:
+    """dL/dT [W m⁻² sr⁻¹ K⁻¹] of the band radiance at the brightness temperature of ``radiance``.
+
+    The reciprocal of the slope of the same Hermite T(L) that :func:`brightness_temperature`
+    interpolates (exact dT/dL at the 0.25 K nodes, O(h³) between them); outside 100–500 K the
+    band sum of ∂B_λ/∂T at the Newton temperature. A per-pixel lookup, no band sum per pixel
+    (what a noise model needs: NEΔL = NETD · dL/dT).
+    """
+    check_finite_range("radiance", radiance, 0.0, lo_open=True, unit="W m-2 sr-1")
+    b = as_band(band, response)
+    dtype, device = resolve_dtype_device(radiance=radiance)
+    L = as_tensor(radiance, dtype, device)
+    i, t, inside, (_, inv_h, _, c1, c2, c3) = _bt_hermite(L, b)
+    out = 1.0 / ((c1[i] + t * (2.0 * c2[i] + 3.0 * t * c3[i])) * inv_h[i])
+    if not bool(inside.all()):
+        lam, w = b.nodes(dtype, device)
+        T = brightness_temperature(L, b)
+        out = torch.where(inside, out, (_planck_dT(lam, T.unsqueeze(-1)) * w).sum(-1))
     return out
 
 

@@ -36,7 +36,7 @@ import torch
 from torch import nn
 
 from ._validation import as_tensor, check_finite_range, per_batch, resolve_dtype_device
-from .radiometry import LWIR, _planck_dT, as_band, band_radiance, brightness_temperature
+from .radiometry import LWIR, _planck_dT, as_band, band_radiance, band_radiance_slope
 
 __all__ = [
     "optics_blur",
@@ -120,33 +120,6 @@ def _band_radiance_dT(temperature: torch.Tensor, band: Any) -> torch.Tensor:
     out = torch.zeros_like(temperature)
     for s in range(0, n, chunk):
         out = out + (_planck_dT(lam[s:s + chunk], t) * w[s:s + chunk]).sum(-1)
-    return out
-
-
-_DT_LO, _DT_HI, _DT_STEP = 100.0, 500.0, 0.25
-_dldt_cache: dict[tuple, torch.Tensor] = {}
-
-
-def _band_radiance_dT_table(temperature: torch.Tensor, band: Any) -> torch.Tensor:
-    """dL/dT at many pixels: :func:`_band_radiance_dT` tabulated every 0.25 K over 100–500 K (per
-    band, dtype, device; float64-made) and interpolated linearly: within 1.3e-5 (LWIR) and 1e-4
-    (MWIR) relative of the exact sum over 150–450 K, far below any NETD's own uncertainty (outside
-    the table: the exact sum). The exact sum costs one Planck derivative per band node per pixel
-    (~170 ms for a 512×640 image on one core), the table ~2 ms."""
-    b = as_band(band)
-    key = (hash(b), temperature.dtype, temperature.device)
-    tab = _dldt_cache.get(key)
-    if tab is None:
-        T = torch.arange(_DT_LO, _DT_HI + _DT_STEP / 2, _DT_STEP, dtype=torch.float64)
-        tab = _band_radiance_dT(T, b).to(dtype=temperature.dtype, device=temperature.device)
-        _dldt_cache[key] = tab
-    f = (temperature - _DT_LO) / _DT_STEP
-    i = f.detach().floor().clamp(0, tab.numel() - 2).long()
-    w = f - i
-    out = torch.lerp(tab[i], tab[i + 1], w)
-    inside = (temperature >= _DT_LO) & (temperature <= _DT_HI)
-    if not bool(inside.all()):
-        out = torch.where(inside, out, _band_radiance_dT(temperature, b))
     return out
 
 
@@ -307,8 +280,7 @@ def _noise_std(radiance: torch.Tensor, netd: torch.Tensor, band: Any,
         t = torch.tensor(reference_temperature, dtype=radiance.dtype, device=radiance.device)
         return netd * _band_radiance_dT(t, band)
     floor = band_radiance(torch.tensor(_T_FLOOR, dtype=radiance.dtype, device=radiance.device), band)
-    t = brightness_temperature(torch.maximum(radiance, floor), band)
-    return netd * _band_radiance_dT_table(t, band)
+    return netd * band_radiance_slope(torch.maximum(radiance, floor), band)
 
 
 def detector_noise(
