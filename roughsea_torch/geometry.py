@@ -182,6 +182,7 @@ def view_geometry(
     cz, sea, dz = cat("cos"), cat("sea"), cat("dz")
     out = ViewGeometry(cz, sea, cat("dx"), cat("dy"), lambda: geo.slant_range(cz, sea, dz))
     out.altitude_m = geo.alt.to(geo.dtype)
+    out.earth_radius_m = float(earth_radius_m)
     return out
 
 
@@ -202,6 +203,7 @@ class CameraGeometry:
         self.dtype = dtype = cameras.intrinsics.dtype
         self.device = dev = cameras.device()
         self.flat = flat = math.isinf(earth_radius_m)
+        self.earth_radius_m = float(earth_radius_m)
         centres = -(cameras.rotation_matrix.transpose(-1, -2) @ cameras.translation_vector)[..., 0]
         P = centres.to(torch.float64)
         if not flat:
@@ -222,15 +224,15 @@ class CameraGeometry:
             self.s_h = (torch.sqrt(alt * (2 * Re + alt)) / (Re + alt)).to(dtype)  # sine of the horizon dip
             self.num = (alt * (2 * Re + alt) / (Re + alt)).to(dtype)  # h (2R + h)/(R + h) [m]
 
-    def pixels(self, sl: slice, need_xy: bool = True) -> dict[str, torch.Tensor]:
-        """cos θ̂ (sea) / cos of the ray's zenith (sky), the sea mask, and the unit ray's local-vertical
-        component (and, with ``need_xy``, its world x and y components), for the cameras ``sl``:
-        each (b, H, W).
+    def ray_components(self, sl: slice, need_xy: bool = True) -> tuple[torch.Tensor, ...]:
+        """World components of the unit ray of every pixel of the cameras ``sl``, each (b, H, W): dz
+        along the local vertical and, with ``need_xy``, dx and dy along world x and y (else None).
 
         Pixel rays come from kornia's unprojection. For a pinhole without skew the normalized ray
         (x, y, 1) has x depending on the column only and y on the row only, so kornia unprojects one
         row and one column of pixel centres and each component (a·(x, y, 1))/|(x, y, 1)| is formed
-        by broadcasting: no (b, H, W, 3) tensor. With skew, ``unproject_meshgrid`` does it all.
+        by broadcasting: no (b, H, W, 3) tensor, two full-size operations a component. With skew,
+        ``unproject_meshgrid`` does it all.
         """
         H, W = self.H, self.W
         K = self.cameras.camera_matrix[sl].to(self.dtype)
@@ -243,7 +245,7 @@ class CameraGeometry:
             col = torch.stack([torch.zeros_like(v), v], -1).expand(b_, H, 2)
             x = normalize_points_with_intrinsics(row, K)[..., 0][:, None, :]  # (b, 1, W)
             y = normalize_points_with_intrinsics(col, K)[..., 1][:, :, None]  # (b, H, 1)
-            inv = torch.rsqrt(x * x + y * y + 1.0)
+            inv = torch.rsqrt(x * x + (y * y + 1.0))  # one full-size add
 
             def comp(i: int) -> torch.Tensor:
                 a = A[:, i]
@@ -254,7 +256,13 @@ class CameraGeometry:
             def comp(i: int) -> torch.Tensor:
                 return (rays * A[:, i, None, None, :]).sum(-1)
 
-        dz = comp(2)
+        return (comp(2), comp(0), comp(1)) if need_xy else (comp(2), None, None)
+
+    def pixels(self, sl: slice, need_xy: bool = True) -> dict[str, torch.Tensor]:
+        """cos θ̂ (sea) / cos of the ray's zenith (sky), the sea mask, and the unit ray's local-vertical
+        component (and, with ``need_xy``, its world x and y components), for the cameras ``sl``:
+        each (b, H, W). See :meth:`ray_components`."""
+        dz, dx, dy = self.ray_components(sl, need_xy)
         if self.flat:
             sea = dz < 0
             cos_t = -dz
@@ -265,8 +273,52 @@ class CameraGeometry:
             cos_t = self.k_r[sl, None, None] * torch.sqrt(((-dz - sh) * (-dz + sh)).clamp_min(0.0))  # √(b² − c)/R
         out = {"cos": torch.where(sea, cos_t, dz), "sea": sea, "dz": dz}
         if need_xy:
-            out["dx"], out["dy"] = comp(0), comp(1)
+            out["dx"], out["dy"] = dx, dy
         return out
+
+    def _rays(self, sl: slice, uv: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """World components (dz along the local vertical, dx, dy) of the unit rays through the pixel
+        coordinates ``uv`` (N, 2) of the cameras ``sl``: each (b, N)."""
+        K = self.cameras.camera_matrix[sl].to(self.dtype)
+        xy = normalize_points_with_intrinsics(uv.to(self.dtype).expand(K.shape[0], -1, 2), K)
+        x, y = xy[..., 0], xy[..., 1]
+        inv = torch.rsqrt(x * x + y * y + 1.0)
+        A = self.axes_cam[sl]
+
+        def comp(i: int) -> torch.Tensor:
+            return (A[:, i, 0, None] * x + A[:, i, 1, None] * y + A[:, i, 2, None]) * inv
+
+        return comp(2), comp(0), comp(1)
+
+    def border(self, sl: slice = slice(None)) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Ray components (dz, dx, dy), each (b, 2(H + W) − 4), of the pixels on the image's border,
+        in order around it (top row left to right, right column, bottom row right to left, left
+        column): a closed loop. A smooth function of the ray (its local-vertical component, its
+        azimuth) takes its extremes over the image on this loop, unless the image contains a
+        critical point of it: the nadir or the zenith (:meth:`poles_in_view`)."""
+        H, W = self.H, self.W
+        dev = self.device
+        u = torch.arange(W, dtype=torch.float64, device=dev)
+        v = torch.arange(H, dtype=torch.float64, device=dev)
+        top = torch.stack([u, torch.zeros_like(u)], -1)
+        right = torch.stack([torch.full_like(v[1:], W - 1.0), v[1:]], -1)
+        bottom = torch.stack([u.flip(0)[1:], torch.full_like(u[1:], H - 1.0)], -1) if H > 1 else top[:0]
+        left = torch.stack([torch.zeros_like(v[1:-1]), v.flip(0)[1:-1]], -1) if W > 1 else top[:0]
+        return self._rays(sl, torch.cat([top, right, bottom, left])[None])
+
+    def poles_in_view(self, sl: slice = slice(None)) -> tuple[torch.Tensor, torch.Tensor]:
+        """Whether the nadir and the zenith (the local vertical through the camera) project into the
+        image, or within a pixel of it: (b,) bool each."""
+        K = self.cameras.camera_matrix[sl].to(torch.float64)[:, :3, :3]
+        up = self.axes_cam[sl, 2].to(torch.float64)  # the local vertical in camera axes (b, 3)
+        out = []
+        for d in (-up, up):
+            p = (K @ d[..., None])[..., 0]
+            z = p[:, 2]
+            zs = torch.where(z > 0, z, torch.ones_like(z))
+            u, v = p[:, 0] / zs, p[:, 1] / zs
+            out.append((z > 0) & (u >= -1.0) & (u <= self.W) & (v >= -1.0) & (v <= self.H))
+        return out[0], out[1]
 
     def slant_range(self, cz: torch.Tensor, sea: torch.Tensor, dz: torch.Tensor, sl: slice = slice(None)) -> torch.Tensor:
         """Slant range [m] to the sea (inf for sky pixels) from ``pixels(sl)``'s output."""

@@ -4,20 +4,23 @@ Sea pixels get the apparent radiance of Eq. 10 at their own view angles (θ̂, �
 the sky radiance along their own ray. Two methods:
 
 - ``method="table"`` (default): per image, the model is evaluated only over the view angles its sea
-  pixels span, at Chebyshev–Lobatto nodes in ζ = asinh(cos θ̂ / ε) (ε ~ the rms slope, so the
-  boundary layer at the horizon, where R_a changes fastest, is resolved) and, for anisotropic
-  slopes only, in the relative azimuth. The two sea-temperature-free integrals (T_s, T_ρ) of
-  :func:`~roughsea_torch.expectation.reflection_terms` are resampled spectrally to a fine uniform
-  table and read per pixel by one bilinear ``torch.nn.functional.grid_sample``; the pixel value is
-  R_B (1 − T_ρ) + T_s. Accuracy: within 2e-5 relative of the direct evaluation, horizon rows
+  pixels span (read from the image's border, where the extremes of the view angles lie), at
+  Chebyshev–Lobatto nodes in ζ = asinh(cos θ̂ / ε) (ε ~ the rms slope, so the boundary layer at the
+  horizon, where R_a changes fastest, is resolved) and, for anisotropic slopes only, in the
+  relative azimuth. The node values are resampled spectrally to one fine table per image that also
+  holds, per row, the path (τ · R_a + L_path: for one camera the slant range is a function of θ̂
+  alone) and, in a second block of rows, the sky radiance along the sky pixels' rays. Each pixel
+  then costs its ray, its table coordinates and one bilinear ``torch.nn.functional.grid_sample``.
+  Accuracy: within a few 1e-6 relative of the direct evaluation, horizon rows and sky pixels
   included (``tests/test_render.py``).
-- ``method="direct"``: ``apparent_radiance`` at every sea pixel (the baseline; slow).
+- ``method="direct"``: ``apparent_radiance``, the path and the sky at every pixel (the baseline;
+  slow).
 
 What a scene does not need is left out (measured by ``pipelines/bench_render.py``): no sky work
 when no pixel sees sky; no azimuth dimension (and no per-pixel azimuth) when the slopes are
-isotropic; table nodes only over the angles the sea pixels span; no autograd graph when nothing
-requires grad; per-pixel temporaries for ``chunk`` images at a time (a batch of 64 512×640 images
-fits in a few times its output).
+isotropic; no path rows without a path; table nodes only over the angles the sea pixels span; no
+autograd graph when nothing requires grad; per-pixel temporaries for ``chunk`` images at a time
+(a batch of 64 512×640 images fits in a few times its output).
 """
 
 from __future__ import annotations
@@ -62,7 +65,8 @@ class SeaScene:
         shadowing: Eq. 5 (True) or Eq. 7.
         path: the air between sea and sensor: radiance at the sensor = τ · R_a + L_path per sea pixel,
             from its slant range and the camera's altitude (``roughsea_torch.atmosphere.load_path``;
-            altitudes and ranges outside the tables are clamped to them). ``None`` (default): on
+            a camera outside the tables' 2 m – 5 km is a ``ValueError`` at render time; ranges
+            beyond the tables, on a flat sea, are held at the horizon's). ``None`` (default): on
             whenever ``sky`` is a named atmosphere, off otherwise; ``False``: off; ``True`` or a name
             or an ``AtmosphericPath``: on. On by default because it matters at every range a sea
             scene spans: LWIR midlatitude summer from 20 m, τ = 0.95 at 100 m, 0.75 at 1 km, 0.05 at
@@ -140,6 +144,8 @@ class SeaScene:
         if path is not False and not callable(path):
             raise ValueError(f"path must be None, a bool, an atmosphere name or an AtmosphericPath; got {path!r}")
         self.path = path or None
+        # sky pixels of a named atmosphere with its path on: the sky seen from the camera's altitude
+        self.observer_sky = None
         if air_temperature is not None:
             if self.atmosphere is None:
                 raise ValueError("air_temperature needs a named atmosphere (sky='<name>'); scale a custom sky yourself")
@@ -149,7 +155,6 @@ class SeaScene:
             self._atmosphere_air_temperature = surface_air_temperature(self.atmosphere)
         self.air_temperature = air_temperature
         self.refractive_index = refractive_index
-        self._band_index: torch.Tensor | None = None  # the band-effective water index, made on first use
         self.shadowing = shadowing
 
     @property
@@ -179,12 +184,9 @@ class SeaScene:
             t_sea = per_batch("sea_temperature", self.sea_temperature, B, dtype, device)
             rb = band_radiance(t_sea, self.band)
         m = self.refractive_index
-        if m is None:  # per scene, not per render: the fit depends only on the band and T_sea
-            if self._band_index is None:
-                t_own = self.sea_temperature if self.sea_temperature is not None else 300.0
-                t_own = t_own.detach().double().cpu() if isinstance(t_own, torch.Tensor) else float(t_own)
-                self._band_index = _band_index(self.band, t_own)
-            m = self._band_index
+        if m is None:  # the band-effective water index at each image's sea temperature (a lookup)
+            t_idx = t_sea if self.sea_radiance is None else brightness_temperature(rb.clamp_min(1e-30), self.band)
+            m = _band_index(self.band, t_idx.double())
         n, k = split_refractive_index(m, dtype, device)
         air_scale = None
         if self.air_temperature is not None:  # B(T_air) / B(T_atm): scales sky and path radiance
@@ -198,25 +200,44 @@ class SeaScene:
                     air_scale=air_scale)
 
 
+_INDEX_T0, _INDEX_DT, _INDEX_NT = 180.0, 2.0, 91  # the band-index table: 180-360 K every 2 K
+
+
 @lru_cache(maxsize=16)
 def _band_index_table(band: SpectralBand) -> tuple[torch.Tensor, torch.Tensor]:
-    t = torch.arange(180.0, 362.0, 2.0, dtype=torch.float64)
-    return t, band_refractive_index(band, t)
+    """n and k of the band-effective water index at 180–360 K every 2 K, (2, N_T), and their
+    T-derivatives at the nodes, (2, N_T): 4th-order centred differences (2nd-order one-sided at the
+    ends; the fit is smooth in T)."""
+    t = _INDEX_T0 + _INDEX_DT * torch.arange(_INDEX_NT, dtype=torch.float64)
+    m = band_refractive_index(band, t)
+    y = torch.stack([m.real, m.imag])
+    d = torch.empty_like(y)
+    d[:, 2:-2] = (y[:, :-4] - 8 * y[:, 1:-3] + 8 * y[:, 3:-1] - y[:, 4:]) / (12 * _INDEX_DT)
+    d[:, 1], d[:, -2] = (y[:, 2] - y[:, 0]) / (2 * _INDEX_DT), (y[:, -1] - y[:, -3]) / (2 * _INDEX_DT)
+    d[:, 0] = (-3 * y[:, 0] + 4 * y[:, 1] - y[:, 2]) / (2 * _INDEX_DT)
+    d[:, -1] = (3 * y[:, -1] - 4 * y[:, -2] + y[:, -3]) / (2 * _INDEX_DT)
+    return y, d
 
 
-def _band_index(band: SpectralBand, temperature: Any) -> torch.Tensor:
-    """The band-effective water index at T_sea [K] (float or tensor): ``band_refractive_index``
-    tabulated every 2 K over 180–360 K per band and interpolated linearly (within 1.2e-6 of the
-    direct fit in LWIR, 2e-7 in MWIR; a fit costs ~20 ms per call, a lookup ~0.1 ms)."""
+def _band_index(band: SpectralBand, temperature: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """The band-effective water index (n, k) at T_sea [K] (a float64 tensor, any shape):
+    ``band_refractive_index`` tabulated every 2 K over 180–360 K per band and read by a cubic
+    Hermite interpolant, differentiable in T (within 1e-8 of the direct fit; a fit costs ~20 ms,
+    a lookup ~0.1 ms). Its T-derivative is the interpolant's, so the gradient of an image with
+    respect to the sea temperature includes how the Planck weights of the band move the index."""
     try:
-        t, m = _band_index_table(band)
+        y, d = _band_index_table(band)
     except TypeError:  # a band with an unhashable response (e.g. arrays): fit directly
-        return band_refractive_index(band, temperature)
-    tq = torch.as_tensor(temperature, dtype=torch.float64)
-    f = ((tq - t[0]) / (t[1] - t[0])).clamp(0.0, t.numel() - 1.0)
-    i = f.floor().long().clamp(max=t.numel() - 2)
-    w = (f - i).to(m.dtype)
-    return m[i] * (1 - w) + m[i + 1] * w
+        m = band_refractive_index(band, temperature)
+        return m.real, m.imag
+    y, d = y.to(temperature.device), d.to(temperature.device)
+    f = ((temperature - _INDEX_T0) / _INDEX_DT).clamp(0.0, _INDEX_NT - 1.0)
+    i = f.detach().floor().long().clamp(max=_INDEX_NT - 2)
+    s = f - i
+    s2, s3 = s * s, s * s * s
+    h00, h10, h01, h11 = 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, 3 * s2 - 2 * s3, s3 - s2
+    out = h00 * y[:, i] + h10 * _INDEX_DT * d[:, i] + h01 * y[:, i + 1] + h11 * _INDEX_DT * d[:, i + 1]
+    return out[0], out[1]
 
 
 @dataclass(frozen=True)
@@ -230,24 +251,34 @@ class TableSize:
             rms slope < 0.2: Cox–Munk below ~0.04 m/s, |r| near 1): R_a then changes sharply with
             azimuth at grazing views (views along the wind at W = 0: 2e-4 with 9 nodes, 1.5e-6 with
             33, folded; ``tests/test_render.py``).
+        zenith_thin: nodes in ζ when a slope ellipse is thin (its grazing layer then changes
+            sharply with azimuth, and the spans read from the cameras' border start at the
+            horizon, ζ = 0): W = 0 along the wind, 1.3e-4 with 21 nodes, 7e-6 with 41.
         fine_zenith, fine_azimuth: rows/columns of the fine table read by ``grid_sample``.
+        fine_sky: rows of the sky block of the fine table, evenly spaced in the cosine of the ray's
+            zenith over the span of the image's sky pixels.
         span: ``"pixels"`` (default): nodes only over the angles the image's sea pixels span;
             ``"full"``: over every angle (θ̂ in [0°, 90°], every azimuth), for comparison.
     """
 
-    zenith: int = 25
-    azimuth: int = 9
+    zenith: int = 21
+    azimuth: int = 7
     fine_zenith: int = 4096
     fine_azimuth: int = 128
     span: str = "pixels"
     azimuth_thin: int = 33
+    fine_sky: int = 2048
+    zenith_thin: int = 41
 
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):
             raise ValueError(f"TableSize.span must be 'pixels' or 'full'; got {self.span!r}")
-        for name in ("zenith", "azimuth", "azimuth_thin", "fine_zenith", "fine_azimuth"):
+        for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin"):
             if int(getattr(self, name)) < 2:
                 raise ValueError(f"TableSize.{name} must be >= 2")
+        for name in ("fine_zenith", "fine_azimuth", "fine_sky"):
+            if int(getattr(self, name)) < 4 * _EXT + 2:
+                raise ValueError(f"TableSize.{name} must be >= {4 * _EXT + 2}")
 
 
 _EXT = 2  # fine cells beyond each end of the node interval, so no pixel reads the clamped border
@@ -304,37 +335,173 @@ def _sky_radiance_pixels(sky: Any, cos_z: torch.Tensor) -> torch.Tensor:
 
 
 def _masked_range(x: torch.Tensor, mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-    """Per-image (min, max) of x over mask, (B, H, W) → (B,), detached."""
+    """Per-image (min, max) of x over mask, (B, H, W) → (B,), detached (±inf where mask is empty)."""
     inf = torch.tensor(math.inf, dtype=x.dtype, device=x.device)
     x = x.detach()
     return torch.where(mask, x, inf).amin((1, 2)), torch.where(mask, x, -inf).amax((1, 2))
 
 
-def _azimuth_offsets(
-    dx: torch.Tensor, dy: torch.Tensor, wind_direction: torch.Tensor, mask: torch.Tensor
-) -> tuple[torch.Tensor, torch.Tensor]:
-    """Per-image centre c (b,) of the relative azimuths φ̂ = atan2(−dy, −dx) − wind direction of the
-    sea pixels, and per-pixel ``wrap_π(φ̂ − c) + π/2`` ∈ [0, π) (b, H, W).
+def _wrap(x: torch.Tensor) -> torch.Tensor:
+    """Angles wrapped into [−π, π)."""
+    return torch.remainder(x + math.pi, 2 * math.pi) - math.pi
 
-    Period π: the slope density is symmetric under s → −s, so R_a(φ̂ + π) = R_a(φ̂). The centre is
-    the circular mean of 2φ̂ over a subsample of the sea pixels, halved; the per-pixel work is one
-    atan2, one add of a per-image constant and one remainder.
-    """
+
+def _azimuth_centre(dx: torch.Tensor, dy: torch.Tensor, wind_direction: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    """Per-image centre c (b,) of the relative azimuths φ̂ = atan2(−dy, −dx) − wind direction of the
+    masked pixels: the circular mean of 2φ̂ (period π: R_a(φ̂ + π) = R_a(φ̂)) over a subsample, halved."""
     step = max(1, int(math.sqrt(dx[0].numel() / 4096)))  # ~4096 pixels suffice for a centre
     ps = torch.atan2(-dy[:, ::step, ::step], -dx[:, ::step, ::step]).detach() - wind_direction.detach()[:, None, None]
     m = mask[:, ::step, ::step]
     m = m | ~m.flatten(1).any(1)[:, None, None]  # no sea in the subsample: use all of it
     zero = torch.zeros((), dtype=dx.dtype, device=dx.device)
-    c = 0.5 * torch.atan2(torch.where(m, torch.sin(2 * ps), zero).sum((1, 2)), torch.where(m, torch.cos(2 * ps), zero).sum((1, 2)))
-    k = (math.pi / 2 - c - wind_direction)[:, None, None]
-    return c, torch.remainder(torch.atan2(-dy, -dx) + k, math.pi)
+    return 0.5 * torch.atan2(torch.where(m, torch.sin(2 * ps), zero).sum((1, 2)), torch.where(m, torch.cos(2 * ps), zero).sum((1, 2)))
 
 
-def _azimuth_folded(dx: torch.Tensor, dy: torch.Tensor, wind_direction: torch.Tensor) -> torch.Tensor:
-    """Per pixel ψ = |wrap(φ̂)| ∈ [0, π/2], φ̂ = atan2(−dy, −dx) − wind direction wrapped to
-    [−π/2, π/2) (period π): the relative azimuth folded by the mirror symmetry of uncorrelated slopes."""
-    k = (math.pi / 2 - wind_direction)[:, None, None]
-    return (torch.remainder(torch.atan2(-dy, -dx) + k, math.pi) - math.pi / 2).abs()
+def _azimuth_coordinate(dx: torch.Tensor, dy: torch.Tensor, offset: torch.Tensor, fold: bool) -> torch.Tensor:
+    """The table's azimuth coordinate of each pixel, (b, H, W), from its ray's world x, y components.
+
+    ``fold`` (uncorrelated slopes, ``offset`` = π/2 − wind direction): ψ = |φ̂| folded into
+    [0, π/2] by the mirror symmetries R_a(φ̂) = R_a(−φ̂) = R_a(π − φ̂); otherwise (``offset`` =
+    π/2 − c − wind direction, c the image's centre azimuth): o = wrap_π(φ̂ − c) + π/2 ∈ [0, π)."""
+    # atan2(dy, dx) is the ray's azimuth, the LOS's + π: the same modulo π
+    o = torch.remainder(torch.atan2(dy, dx) + offset[:, None, None], math.pi)
+    return (o - math.pi / 2).abs() if fold else o
+
+
+def _fold_range(a: torch.Tensor, b: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """Range of ψ = |wrap_π(φ)| (period π, values in [0, π/2]) over φ ∈ [a, b] (lifted, b − a < π)."""
+    psi = lambda x: (torch.remainder(x + math.pi / 2, math.pi) - math.pi / 2).abs()  # noqa: E731
+    pa, pb = psi(a), psi(b)
+    has_zero = torch.ceil(a / math.pi) * math.pi <= b
+    has_edge = torch.ceil((a - math.pi / 2) / math.pi) * math.pi + math.pi / 2 <= b
+    lo = torch.where(has_zero, torch.zeros_like(a), torch.minimum(pa, pb))
+    hi = torch.where(has_edge, torch.full_like(b, math.pi / 2), torch.maximum(pa, pb))
+    return lo, hi
+
+
+@dataclass
+class _Ranges:
+    """Per-image spans (B,) float64, detached: ζ of the sea pixels, the azimuth coordinate of the sea
+    pixels (with the centre c of the unfolded coordinate), and the cosine of the ray's zenith of the
+    sky pixels; whether an image has sea / sky pixels."""
+
+    zeta: tuple[torch.Tensor, torch.Tensor]
+    sky: tuple[torch.Tensor, torch.Tensor]
+    any_sea: torch.Tensor
+    any_sky: torch.Tensor
+    azimuth: tuple[torch.Tensor, torch.Tensor] | None = None
+    centre: torch.Tensor | None = None
+
+
+def _asinh(x: torch.Tensor) -> torch.Tensor:
+    return torch.log(x + torch.sqrt(x * x + 1.0))  # 3× faster than torch.asinh on CPU
+
+
+def _camera_ranges(cg: CameraGeometry, wd: torch.Tensor, inv_eps: torch.Tensor, iso: bool, fold: bool) -> _Ranges:
+    """The spans of an image from the rays of its border alone (no per-pixel work).
+
+    cos θ̂ of a sea pixel grows with −dz (the ray's local-vertical component), and dz and the LOS
+    azimuth are smooth functions of the ray whose only critical points are the nadir and the zenith:
+    over the image they take their extremes on its border, unless a pole is in view. The sea pixels'
+    azimuths span those of the sea part of the border plus the horizon arc, which is monotone in
+    azimuth between its ends on the border. Spans are widened by one border step (the sampled border
+    against the continuous one).
+    """
+    with torch.no_grad():
+        dz, dx, dy = (t.double() for t in cg.border())
+        nadir, zenith = cg.poles_in_view()
+        B = dz.shape[0]
+        sh = torch.zeros(B, dtype=torch.float64, device=dz.device) if cg.flat else cg.s_h.double()
+        kr = torch.ones_like(sh) if cg.flat else cg.k_r.double()
+        dz_min = torch.where(nadir, -torch.ones_like(sh), dz.amin(1))
+        dz_max = torch.where(zenith, torch.ones_like(sh), dz.amax(1))
+        any_sea = -dz_min > sh
+        any_sky = dz_max > -sh - 1e-6
+
+        def zeta(d: torch.Tensor) -> torch.Tensor:  # ζ of the sea point met by a ray of vertical component d
+            cos_t = (-d) if cg.flat else kr * torch.sqrt(((-d - sh) * (-d + sh)).clamp_min(0.0))
+            return torch.asinh(cos_t.clamp_min(0.0) * inv_eps.double())
+
+        z_hi = zeta(dz_min)
+        z_lo = torch.where(any_sky, torch.zeros_like(z_hi), zeta(dz_max))
+        s_lo, s_hi = torch.maximum(dz_min, -sh), dz_max
+        if iso:
+            return _Ranges((z_lo, z_hi), (s_lo, s_hi), any_sea, any_sky)
+        # the LOS azimuth along the border, lifted (unwrapped) around the loop
+        phi = torch.atan2(-dy, -dx)
+        steps = _wrap(torch.roll(phi, -1, 1) - phi)  # step k: from point k to k + 1 (the last closes the loop)
+        lifted = torch.cat([phi[:, :1], phi[:, :1] + torch.cumsum(steps[:, :-1], 1)], 1)
+        step_max = steps.abs().amax(1)
+        sea_b = -dz > sh[:, None]
+        inf = torch.tensor(math.inf, dtype=torch.float64, device=dz.device)
+        a = torch.where(sea_b, lifted, inf).amin(1) - step_max - wd.double()
+        b = torch.where(sea_b, lifted, -inf).amax(1) + step_max - wd.double()
+        # a pole in view, a loop that winds around one, or a border too coarse to lift: every azimuth
+        full = nadir | zenith | (steps.sum(1).abs() > math.pi) | (step_max > 0.5) | ~sea_b.any(1) | (b - a >= math.pi)
+        if fold:
+            lo, hi = _fold_range(torch.where(full, torch.zeros_like(a), a), torch.where(full, torch.zeros_like(b), b))
+            lo = torch.where(full, torch.zeros_like(lo), lo)
+            hi = torch.where(full, torch.full_like(hi, math.pi / 2), hi)
+            return _Ranges((z_lo, z_hi), (s_lo, s_hi), any_sea, any_sky, (lo, hi), torch.zeros_like(lo))
+        c = torch.where(full, torch.zeros_like(a), 0.5 * (a + b))
+        half = 0.5 * (b - a)
+        lo = torch.where(full, torch.zeros_like(a), math.pi / 2 - half)
+        hi = torch.where(full, torch.full_like(b, math.pi), math.pi / 2 + half)
+        return _Ranges((z_lo, z_hi), (s_lo, s_hi), any_sea, any_sky, (lo, hi), c)
+
+
+def _geometry_ranges(g: ViewGeometry, wd: torch.Tensor, inv_eps: torch.Tensor, iso: bool, fold: bool) -> _Ranges:
+    """The spans of an image from a precomputed per-pixel :class:`ViewGeometry`."""
+    with torch.no_grad():
+        sea = g.is_sea
+        any_sea, any_sky = sea.flatten(1).any(1), (~sea).flatten(1).any(1)
+        z = _masked_range(_asinh(g.cos_view_zenith.clamp_min(0.0) * inv_eps[:, None, None]), sea)
+        s = _masked_range(g.cos_view_zenith, ~sea)
+        out = _Ranges(tuple(v.double() for v in z), tuple(v.double() for v in s), any_sea, any_sky)
+        if not iso:
+            c = torch.zeros_like(wd) if fold else _azimuth_centre(g._dx, g._dy, wd, sea)
+            o = _azimuth_coordinate(g._dx, g._dy, math.pi / 2 - c - wd, fold)
+            out.azimuth = tuple(v.double() for v in _masked_range(o, sea))
+            out.centre = c.double()
+        return out
+
+
+def _slant_range(cos_t: torch.Tensor, altitude: torch.Tensor, earth_radius_m: float) -> torch.Tensor:
+    """Slant range [m] from a sensor at altitude h to the sea point whose LOS has local zenith
+    cosine cos θ̂: the near root of (R + h)² = R² + 2 R r cos θ̂ + r², written without cancellation
+    as h (2R + h) / (R cos θ̂ + √(R² cos² θ̂ + h (2R + h))) (flat sea: h / cos θ̂)."""
+    c = cos_t.clamp(0.0, 1.0)
+    if math.isinf(earth_radius_m):
+        return altitude / c.clamp_min(1e-12)
+    num = altitude * (2.0 * earth_radius_m + altitude)
+    rc = earth_radius_m * c
+    return num / (rc + torch.sqrt(rc * rc + num))
+
+
+def _check_path_altitude(path: Any, altitude: torch.Tensor) -> None:
+    if getattr(path, "altitude_range_m", None) is None:  # a user's own path model
+        return
+    lo, hi = path.altitude_range_m
+    h = altitude.detach()
+    bad = ~((h >= lo * (1 - 1e-5)) & (h <= hi * (1 + 1e-5)))
+    if bool(bad.any()):
+        raise ValueError(f"altitude_m must lie in [{lo:g}, {hi:g}] m, the range of the atmospheric path tables, "
+                         f"when the scene's path is on; got {h[bad][0].item():g} m (SeaScene(path=False) renders "
+                         "without the air between sea and sensor)")
+
+
+def _sky_rows(p: dict[str, Any], scene: SeaScene, cos_z: torch.Tensor, altitude: torch.Tensor) -> torch.Tensor:
+    """Sky radiance seen by each camera along rays of zenith cosine ``cos_z`` (B, N) at the camera
+    (down to the depressed horizon): from the camera's altitude for a named atmosphere, else the
+    scene's sky (rays below the horizontal see its horizon); scaled by the air temperature."""
+    B = cos_z.shape[0]
+    if scene.observer_sky is not None:
+        rad = scene.observer_sky(altitude.to(cos_z.dtype)[:, None], cos_z, clamp=True)
+    else:
+        rad = _sky_radiance_pixels(_sky_per_image(p["sky"], B, cos_z.dtype, cos_z.device, 0), cos_z)
+    if p["air_scale"] is not None:
+        rad = rad * p["air_scale"][:, None].to(rad.dtype)
+    return rad
 
 
 def render(
@@ -383,6 +550,7 @@ def render(
     if method == "direct":
         geom = geometry if geometry is not None else view_geometry(cameras, earth_radius_m)
         sea = geom.is_sea
+        altitude = geom.altitude_m
         img = None
         if bool(sea.any()):
             p_sea = p
@@ -390,39 +558,22 @@ def render(
                 p_sea = dict(p, sky=p["sky"].with_radiance(p["sky"].radiance.to(dtype=dtype, device=device) * p["air_scale"][:, None]))
             img = _sea_direct(geom, p_sea, scene, q)
             if scene.path is not None:
-                img = _apply_path(scene.path, img, geom.altitude_m, geom.range_m, sea, p["air_scale"])
+                _check_path_altitude(scene.path, altitude)
+                img = _apply_path(scene.path, img, altitude, geom.range_m, sea, p["air_scale"])
         if bool((~sea).any()):
-            sky_pix = _sky_pixels(p["sky"], geom.cos_view_zenith, B, dtype, device)
-            if p["air_scale"] is not None:
-                sky_pix = sky_pix * p["air_scale"][:, None, None]
+            sky_pix = _sky_rows(p, scene, geom.cos_view_zenith.reshape(B, -1), altitude).reshape(B, H, W)
             img = sky_pix if img is None else torch.where(sea, img, sky_pix)
         img = img.reshape(B, 1, H, W)
+        if output == "brightness_temperature":
+            return brightness_temperature(img.clamp_min(torch.finfo(dtype).tiny), scene.band)
+        return img
+    if geometry is not None:
+        altitude, radius = geometry.altitude_m, getattr(geometry, "earth_radius_m", earth_radius_m)
+        cg = None
     else:
-        if geometry is not None:
-            g = geometry
-
-            def source(sl: slice) -> dict[str, torch.Tensor]:
-                out = {"cos": g.cos_view_zenith[sl], "sea": g.is_sea[sl], "dx": g._dx[sl], "dy": g._dy[sl]}
-                if scene.path is not None:
-                    out["range"] = g.range_m[sl]
-                return out
-
-            altitude = g.altitude_m
-        else:
-
-            iso = bool(((p["vx"] == p["vy"]) & (p["cxy"] == 0)).all())
-
-            def source(sl: slice) -> dict[str, torch.Tensor]:
-                out = cg.pixels(sl, need_xy=not iso)
-                if scene.path is not None:
-                    out["range"] = cg.slant_range(out["cos"], out["sea"], out["dz"], sl)
-                return out
-
-            altitude = cg.alt.to(dtype)
-        img = _render_table(source, B, H, W, dtype, device, p, scene, q, table, chunk, altitude)[:, None]
-    if output == "brightness_temperature":
-        return brightness_temperature(img.clamp_min(torch.finfo(dtype).tiny), scene.band)
-    return img
+        altitude, radius = cg.alt.to(dtype), earth_radius_m
+    return _render_table(cg, geometry, B, H, W, dtype, device, p, scene, q, table, chunk, altitude, radius,
+                         output == "brightness_temperature")[:, None]
 
 
 def _relative_azimuth(geom: ViewGeometry, p: dict[str, Any]) -> torch.Tensor:
@@ -445,13 +596,6 @@ def _sea_direct(geom: ViewGeometry, p: dict[str, Any], scene: SeaScene, q: Quadr
     return out.index_put((sea,), vals)
 
 
-def _sky_pixels(sky: Any, cos_z: torch.Tensor, B: int, dtype: torch.dtype, device: torch.device) -> torch.Tensor:
-    """Sky radiance along each pixel's ray (b, H, W) for a chunk whose first image is image 0 of
-    ``sky``'s batch (callers slice per-image skies)."""
-    b, H, W = cos_z.shape
-    return _sky_radiance_pixels(_sky_per_image(sky, b, dtype, device, 0), cos_z.reshape(b, -1)).reshape(b, H, W)
-
-
 def _apply_path(path: Any, radiance: torch.Tensor, altitude: torch.Tensor, range_m: torch.Tensor, sea: torch.Tensor,
                 air_scale: torch.Tensor | None = None) -> torch.Tensor:
     """τ · R_a + L_path at each sea pixel (other pixels unchanged); (b, H, W). ``air_scale`` (b,)
@@ -465,7 +609,8 @@ def _apply_path(path: Any, radiance: torch.Tensor, altitude: torch.Tensor, range
 
 
 def _render_table(
-    source: Callable[[slice], dict[str, torch.Tensor]],
+    cg: CameraGeometry | None,
+    geometry: ViewGeometry | None,
     B: int,
     H: int,
     W: int,
@@ -477,10 +622,23 @@ def _render_table(
     table: TableSize,
     chunk: int,
     altitude: torch.Tensor,
+    earth_radius_m: float,
+    brightness: bool,
 ) -> torch.Tensor:
-    """The table method, streaming ``chunk`` images at a time: pass 1 keeps only each pixel's table
-    coordinates (and sky radiance, where sky is seen) and the per-image angle ranges; the model is
-    evaluated once for the batch; pass 2 samples the tables chunk by chunk. Returns (B, H, W)."""
+    """The table method. Per image one fine table holds, in one array read by one bilinear
+    ``grid_sample`` per pixel, everything a pixel can see:
+
+    - rows 0 … M_z − 1 (the sea): τ(ζ) · R_a(ζ, o) + L_path(ζ) over ζ = asinh(cos θ̂/ε) and the
+      azimuth coordinate o. R_a comes from the model at Chebyshev–Lobatto nodes resampled spectrally
+      (barycentric matrices L_z, L_o); the path is exact per row, since for one camera the slant
+      range is a function of θ̂ alone. As matrices, fine = [τ L_z | L_path] · [R_a ; 1] · L_oᵀ.
+    - rows M_z … M_z + M_s − 1 (the sky): the sky radiance over the cosine of the ray's zenith at
+      the camera, constant along o.
+
+    Spans come from the image's border (:func:`_camera_ranges`) or from a given ``geometry``; the
+    model runs once for the batch; pixels are then visited ``chunk`` images at a time, once each.
+    With ``brightness`` the result is in kelvin. Returns (B, H, W).
+    """
     iso = bool(((p["vx"] == p["vy"]) & (p["cxy"] == 0)).all())
     # Uncorrelated anisotropic slopes (Cox–Munk): the table runs over the folded azimuth ψ ∈ [0, π/2].
     # R_a is even in φ̂ there, and as a → 0 (or b → 0) it has a kink at φ̂ = 0 (π/2), where the
@@ -494,72 +652,39 @@ def _render_table(
     inv_eps = (1.0 / eps).to(dtype)
     lam_max = 0.5 * (p["vx"] + p["vy"] + torch.sqrt((p["vx"] - p["vy"]) ** 2 + 4 * p["cxy"] ** 2))
     thin = bool((lam_min.detach() < 0.04 * lam_max.detach()).any())  # minor/major rms slope < 0.2
-    nz, nphi = table.zenith, (1 if iso else max(table.azimuth, table.azimuth_thin) if thin else table.azimuth)
-    xz, Lz, ez = _lobatto_interp(nz, table.fine_zenith)
-    xp, Lp, ep = _lobatto_interp(nphi, 1 if iso else table.fine_azimuth)
-    chunks = []
-    out: torch.Tensor | None = None
-    zlo, zhi, olo, ohi, centre = [], [], [], [], []
-    for i in range(0, B, chunk):
-        sl = slice(i, min(i + chunk, B))
-        px = source(sl)
-        sea = px["sea"]
-        xz_ = px["cos"] * inv_eps[sl, None, None]  # the pixel's own cos θ̂ / ε (sky pixels: masked out)
-        zeta = torch.log(xz_ + torch.sqrt(xz_ * xz_ + 1.0))  # asinh, 3× faster than torch.asinh on CPU
-        lo, hi = _masked_range(zeta, sea)
-        zlo.append(lo)
-        zhi.append(hi)
-        entry: dict[str, Any] = {"sl": sl, "sea": sea, "zeta": zeta, "sky": None, "range": px.get("range")}
-        if fold:  # o = ψ = |φ̂| folded into [0, π/2]: R_a(φ̂) = R_a(−φ̂) = R_a(π − φ̂) when r = 0
-            o = _azimuth_folded(px["dx"], px["dy"], p["wind_direction"][sl])
-            a, b = _masked_range(o, sea)
-            centre.append(torch.zeros_like(a))
-            olo.append(a)
-            ohi.append(b)
-            entry["o"] = o
-        elif not iso:
-            c, o = _azimuth_offsets(px["dx"], px["dy"], p["wind_direction"][sl], sea)  # o ∈ [0, π): offset + π/2
-            a, b = _masked_range(o, sea)
-            centre.append(c)
-            olo.append(a)
-            ohi.append(b)
-            entry["o"] = o
-        if bool((~sea).any()):  # no sky work when no pixel of the chunk sees sky
-            sky_vals = _sky_pixels(select_sky(p["sky"], sl), px["cos"], sl.stop - sl.start, dtype, device)
-            if p["air_scale"] is not None:
-                sky_vals = sky_vals * p["air_scale"][sl, None, None]
-            if out is None:
-                out = torch.zeros(B, H, W, dtype=dtype, device=device)
-            out[sl] = sky_vals  # sky pixels land in the output now; sea pixels overwrite in pass 2
-            entry["sky"] = True
-        del px
-        chunks.append(entry)
-    any_sea = torch.cat([torch.isfinite(z) for z in zlo])
-    lo = torch.where(any_sea, torch.cat(zlo), torch.zeros(B, dtype=dtype, device=device)).double()
-    hi = torch.where(any_sea, torch.cat(zhi), torch.ones(B, dtype=dtype, device=device)).double()
+    nz = max(table.zenith, table.zenith_thin) if thin else table.zenith
+    nphi = 1 if iso else max(table.azimuth, table.azimuth_thin) if thin else table.azimuth
+    wd = p["wind_direction"]
+    rg = (_geometry_ranges(geometry, wd, inv_eps, iso, fold) if geometry is not None
+          else _camera_ranges(cg, wd, inv_eps, iso, fold))
+
+    # ---- node spans (float64) -------------------------------------------------------------------
+    lo, hi = (torch.where(rg.any_sea, v, torch.full_like(v, d)) for v, d in zip(rg.zeta, (0.0, 1.0)))
     if table.span == "full":
         lo, hi = torch.zeros_like(lo), torch.asinh(1.0 / eps)
     pad = torch.clamp(1e-6 * (hi - lo), min=1e-9)
     lo, hi = lo - pad, hi + pad
-    xz_t = torch.as_tensor(xz, dtype=torch.float64, device=device)
-    zeta_n = lo[:, None] + (hi - lo)[:, None] * (xz_t + 1) / 2  # (B, nz)
-    th_nodes = torch.acos((eps[:, None] * torch.sinh(zeta_n)).clamp(0.0, 1.0)).to(dtype)
+    xz, Lz, ez = _lobatto_interp(nz, table.fine_zenith)
+    zeta_n = lo[:, None] + (hi - lo)[:, None] * (torch.as_tensor(xz, dtype=torch.float64, device=device) + 1) / 2
+    th_nodes = torch.acos((eps[:, None] * torch.sinh(zeta_n)).clamp(0.0, 1.0)).to(dtype)  # (B, nz)
     if iso:
         ph_nodes = torch.zeros(B, 1, dtype=dtype, device=device)
     else:
-        c = torch.cat(centre).double()
-        a = torch.where(any_sea, torch.cat(olo), torch.zeros(B, dtype=dtype, device=device)).double()
-        b = torch.where(any_sea, torch.cat(ohi), torch.ones(B, dtype=dtype, device=device)).double()
+        a, b = (torch.where(rg.any_sea, v, torch.full_like(v, d)) for v, d in zip(rg.azimuth, (0.0, 1.0)))
+        c = rg.centre
         if table.span == "full":
             a, b = torch.zeros_like(a), torch.full_like(b, math.pi / 2 if fold else math.pi)
         pad = torch.clamp(1e-6 * (b - a), min=1e-6)
         a, b = a - pad, b + pad
         if fold:  # ψ ∈ [0, π/2]: keep the nodes inside it (the kink stays at the interval's end)
             a, b = a.clamp_min(0.0), b.clamp_max(math.pi / 2)
-        xp_t = torch.as_tensor(xp, dtype=torch.float64, device=device)
+        xp, Lp, ep = _lobatto_interp(nphi, table.fine_azimuth)
         # the pixels' o = wrap_π(φ̂ − c) + π/2: nodes at φ̂ = c + o − π/2 (folded: φ̂ = o = ψ)
         shift = 0.0 if fold else math.pi / 2
+        xp_t = torch.as_tensor(xp, dtype=torch.float64, device=device)
         ph_nodes = (c[:, None] - shift + a[:, None] + (b - a)[:, None] * (xp_t + 1) / 2).to(dtype)
+
+    # ---- the model at the nodes -----------------------------------------------------------------
     vz = th_nodes[:, :, None].expand(B, nz, nphi)
     va = ph_nodes[:, None, :].expand(B, nz, nphi)
     slopes = SlopeStatistics.from_variances(p["vx"][:, None, None], p["vy"][:, None, None], p["cxy"][:, None, None])
@@ -570,37 +695,101 @@ def _render_table(
     if p["air_scale"] is not None:
         t_s = t_s * p["air_scale"][:, None, None].to(t_s.dtype)
     rb = p["rb"][:, None, None].to(t_s.dtype)
-    coarse = (rb - rb * t_rho + t_s).to(dtype)  # R_a at the nodes (B, nz, nphi); linear in the node values
+    coarse = (rb - rb * t_rho + t_s).to(dtype)  # R_a at the nodes (B, nz, nphi)
+
+    # ---- the fine tables' row matrix A = [τ L_z | L_path ; 0 | sky] (B, M_z + M_s, nz + 1) -------
+    Mz, Ms = table.fine_zenith, table.fine_sky
     Lz_t = torch.as_tensor(Lz, dtype=dtype, device=device)
-    Lp_t = torch.as_tensor(Lp, dtype=dtype, device=device)
-    # the fine table (Mz × Mp per image) is made per chunk in pass 2, not for the whole batch
-    lo_t, span_z = lo.to(dtype), (hi - lo).to(dtype)
+    span_z = hi - lo
+    y_z = torch.linspace(-1.0 - ez, 1.0 + ez, Mz, dtype=torch.float64, device=device)
+    if scene.path is not None:
+        _check_path_altitude(scene.path, altitude)
+        zeta_rows = lo[:, None] + span_z[:, None] * (y_z + 1) / 2  # (B, M_z)
+        cos_rows = (eps[:, None] * torch.sinh(zeta_rows)).clamp(0.0, 1.0).to(dtype)
+        h = altitude.to(dtype)[:, None]
+        tau, l_path = scene.path(h.expand_as(cos_rows), _slant_range(cos_rows, h, earth_radius_m), clamp=True)
+        if p["air_scale"] is not None:
+            l_path = l_path * p["air_scale"][:, None].to(dtype)
+        a_sea = torch.cat([tau[:, :, None] * Lz_t, l_path[:, :, None].to(dtype)], -1)
+    else:
+        a_sea = torch.cat([Lz_t, torch.zeros(Mz, 1, dtype=dtype, device=device)], -1).expand(B, Mz, nz + 1)
+    es = 2.0 * _EXT / (Ms - 1 - 2 * _EXT)
+    s_lo, s_hi = (torch.where(rg.any_sky, v, torch.full_like(v, d)) for v, d in zip(rg.sky, (0.0, 1.0)))
+    s_pad = torch.clamp(1e-6 * (s_hi - s_lo), min=1e-7)
+    s_lo, s_hi = s_lo - s_pad, s_hi + s_pad
+    # rows s0 + j ds, j = 0 … M_s − 1, overhanging the span by _EXT rows; a ray at the horizontal
+    # (cos = 0, where a sea-level sky is held constant below, a kink) falls on a row
+    ds = (s_hi - s_lo) * (1.0 + es) / (Ms - 1)
+    s0 = s_lo - _EXT * ds
+    r0 = -s0 / ds
+    s0 = torch.where((r0 > 0) & (r0 < Ms - 1), s0 - (torch.ceil(r0) - r0) * ds, s0)
+    s_rows = (s0[:, None] + ds[:, None] * torch.arange(Ms, dtype=torch.float64, device=device)).to(dtype)
+    if bool(rg.any_sky.any()):
+        sky_rows = _sky_rows(p, scene, s_rows, altitude).to(dtype)
+    else:  # no sky work when no pixel sees sky
+        sky_rows = torch.zeros_like(s_rows)
+    a_sky = torch.cat([torch.zeros(B, Ms, nz, dtype=dtype, device=device), sky_rows[:, :, None]], -1)
+    A = torch.cat([a_sea, a_sky], 1)
+    C = torch.cat([coarse, torch.ones(B, 1, nphi, dtype=dtype, device=device)], 1)  # (B, nz + 1, nphi)
+    Lp_t = None if iso else torch.as_tensor(Lp, dtype=dtype, device=device)
+    per_table = brightness and (Mz + Ms) * (1 if iso else table.fine_azimuth) < H * W  # kelvin per table row
+
+    # ---- per pixel: table coordinates, one grid_sample ------------------------------------------
+    # row r of the fine table ↔ gy = 2 r / (N − 1) − 1; sea rows at ζ = lo + span (y_z + 1)/2,
+    # sky rows at cos = s_lo + span_s (y_s + 1)/2 (both y evenly spaced, overhanging by _EXT rows)
+    N = Mz + Ms
+    k_sea = (2.0 / (N - 1)) * (Mz - 1) / (span_z * (1.0 + ez))  # dgy/dζ
+    b_sea = -1.0 - k_sea * (lo - ez * span_z / 2)
+    k_sky = (2.0 / (N - 1)) / ds
+    b_sky = 2.0 * Mz / (N - 1) - 1.0 - k_sky * s0
+    k_sea, b_sea, k_sky, b_sky = (v.to(dtype) for v in (k_sea, b_sea, k_sky, b_sky))
     if not iso:
-        a_t, span_p = a.to(dtype), (b - a).to(dtype)
-    while chunks:
-        e = chunks.pop(0)
-        sl = e["sl"]
-        zs = (2.0 / (span_z * (1.0 + ez)))[sl, None, None]
-        gy = torch.addcmul(((-2.0 * lo_t / span_z - 1.0) / (1.0 + ez))[sl, None, None], e["zeta"], zs)
+        k_az = (2.0 / ((b - a) * (1.0 + ep))).to(dtype)
+        b_az = ((-2.0 * a / (b - a) - 1.0) / (1.0 + ep)).to(dtype)
+        az_offset = (math.pi / 2 - rg.centre - wd.double()).to(dtype) if not fold else (math.pi / 2 - wd).to(dtype)
+    if cg is not None:
+        zeta_scale = (inv_eps if cg.flat else cg.k_r.to(dtype) * inv_eps)
+    out: torch.Tensor | None = None
+    for i in range(0, B, chunk):
+        sl = slice(i, min(i + chunk, B))
+        has_sky = bool(rg.any_sky[sl].any())
+        if geometry is not None:
+            cos, sea = geometry.cos_view_zenith[sl], geometry.is_sea[sl]
+            dx, dy = geometry._dx[sl], geometry._dy[sl]
+            zeta = _asinh((cos * inv_eps[sl, None, None]).clamp_min(0.0))
+        else:  # ζ straight from the ray's vertical component dz: cos θ̂ / ε = (k_r/ε) √((dz + s_h)(dz − s_h))
+            cos, dx, dy = cg.ray_components(sl, need_xy=not iso)
+            c1 = zeta_scale[sl, None, None]
+            sh = cg.s_h[sl, None, None] if not cg.flat else torch.zeros_like(c1)
+            # q = (cos θ̂/ε)² = c1² (dz² − s_h²); sky pixels (unused) and the horizon row are held at
+            # a tiny q > 0, which keeps √'s gradient finite
+            sea = cos < -sh
+            q = torch.addcmul(-(c1 * sh) ** 2, cos, cos * (c1 * c1)).clamp_min(1e-30)
+            zeta = torch.log(torch.sqrt(q) + torch.sqrt(q + 1.0))
+        gy = torch.addcmul(b_sea[sl, None, None], zeta, k_sea[sl, None, None])
+        if has_sky:  # cos: the sky pixels' cos of the ray's zenith (dz)
+            gy = torch.where(sea, gy, torch.addcmul(b_sky[sl, None, None], cos, k_sky[sl, None, None]))
         if iso:
             gx = torch.zeros_like(gy)
         else:
-            scale = (2.0 / (span_p * (1.0 + ep)))[sl, None, None]
-            shift = ((-2.0 * a_t / span_p - 1.0) / (1.0 + ep))[sl, None, None]
-            gx = torch.addcmul(shift, e["o"], scale)
+            o = _azimuth_coordinate(dx, dy, az_offset[sl], fold)
+            gx = torch.addcmul(b_az[sl, None, None], o, k_az[sl, None, None])
+        if Lp_t is None:
+            fine = A[sl] @ C[sl]  # (b, N, 1)
+        else:  # the sea rows resampled in azimuth; sky rows repeated (not through L_o: its overhang
+            # rows sum to 1 only to rounding, and sky pixels may read the border columns)
+            fine = torch.cat([(A[sl, :Mz] @ C[sl]) @ Lp_t.T, sky_rows[sl, :, None].expand(-1, -1, Lp_t.shape[0])], 1)
+        if per_table:
+            fine = brightness_temperature(fine.clamp_min(torch.finfo(dtype).tiny), scene.band)
         # bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges
         # only to first order; bilinear on the fine table is second order (~1e-7 at 4096 rows).
-        fine = torch.einsum("iz,bzp,jp->bij", Lz_t, coarse[sl], Lp_t)[:, None]  # (b, 1, Mz, Mp)
-        vals = F.grid_sample(fine, torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border", align_corners=True)[:, 0]
-        del fine, gx, gy
-        if scene.path is not None:
-            vals = _apply_path(scene.path, vals, altitude[sl], e["range"], e["sea"],
-                               None if p["air_scale"] is None else p["air_scale"][sl])
-        if e["sky"] is not None:
-            vals = torch.where(e["sea"], vals, out[sl])
+        vals = F.grid_sample(fine[:, None], torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border",
+                             align_corners=True)[:, 0]
+        if brightness and not per_table:
+            vals = brightness_temperature(vals.clamp_min(torch.finfo(dtype).tiny), scene.band)
+        if sl.stop - sl.start == B:
+            return vals
         if out is None:
-            if sl.stop - sl.start == B:
-                return vals
             out = torch.empty(B, H, W, dtype=vals.dtype, device=device)
         out[sl] = vals  # chunks land in place (autograd records the slice copies)
     return out

@@ -94,9 +94,10 @@ class TabulatedSky:
 
     def _tables(self, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, ...]:
         """Per (dtype, device): the nodes z, radiance r, PCHIP slopes d, and for the lookup a
-        uniform bucket grid over [z₀, z_end] (origin, 1/width, first interval of each bucket) whose
-        width is the smallest node spacing, so a bucket meets at most two intervals; for a single
-        table also the power-form coefficients (N−1, 4) of each interval in t ∈ [0, 1]."""
+        uniform bucket grid over [z₀, z_end] (origin, 1/width) whose width is the smallest node
+        spacing, so a bucket meets at most two intervals, with per bucket its first interval and
+        where the next one starts (M, 2); for a single table also per interval (N−1, 6) its start,
+        1/width and the power-form coefficients of the cubic in t ∈ [0, 1] (one gather a query)."""
         key = (dtype, device)
         if self.radiance.requires_grad or key not in self._cache:
             z64 = self.zenith.detach().double().cpu()
@@ -105,16 +106,19 @@ class TabulatedSky:
             m = int(math.ceil(float(z64[-1] - z64[0]) / width)) + 1
             edges = z64[0] + width * torch.arange(m, dtype=torch.float64)
             start = (torch.searchsorted(z64, edges, right=True) - 1).clamp(0, z64.numel() - 2)
+            split = z64[(start + 1).clamp(max=z64.numel() - 1)]  # a query at or past it is in the next interval
             z = self.zenith.to(dtype=dtype, device=device)
             r = self.radiance.to(dtype=dtype, device=device)
             d = pchip_derivatives(z, r)
             bucket = (torch.tensor(float(z64[0]), dtype=dtype, device=device),
-                      torch.tensor(1.0 / width, dtype=dtype, device=device), start.to(device))
+                      torch.tensor(1.0 / width, dtype=dtype, device=device),
+                      torch.stack([start.to(dtype), split.to(dtype)], -1).to(device))
             coef = None
             if r.ndim == 1:  # y(t) = y0 + t (h d0 + t (3Δ − h(2 d0 + d1) + t (−2Δ + h(d0 + d1))))
                 h = z[1:] - z[:-1]
                 dy = r[1:] - r[:-1]
-                coef = torch.stack([r[:-1], h * d[:-1], 3 * dy - h * (2 * d[:-1] + d[1:]), -2 * dy + h * (d[:-1] + d[1:])], -1)
+                coef = torch.stack([z[:-1], 1.0 / h, r[:-1], h * d[:-1], 3 * dy - h * (2 * d[:-1] + d[1:]),
+                                    -2 * dy + h * (d[:-1] + d[1:])], -1)
             out = (z, r, d, *bucket, coef)
             if self.radiance.requires_grad:
                 return out
@@ -123,23 +127,22 @@ class TabulatedSky:
 
     def __call__(self, cos_zenith: torch.Tensor) -> torch.Tensor:
         cz = cos_zenith
-        z, r, d, z0, inv_w, start, coef = self._tables(cz.dtype, cz.device)
+        z, r, d, z0, inv_w, bucket, coef = self._tables(cz.dtype, cz.device)
         # acos has an infinite slope at cos = 1: hold the query a rounding step away from it.
         one = 1.0 - torch.finfo(cz.dtype).eps
-        theta = torch.acos(cz.clamp(0.0, one))
-        theta = torch.minimum(torch.maximum(theta, z[0]), z[-1])
-        # interval index: the bucket's first interval, plus one where θ is past its end (a
-        # gather and a compare instead of a binary search)
+        theta = torch.acos(cz.clamp(0.0, one)).clamp(z[0], z[-1])
+        # interval index: the bucket's first interval, plus one where θ is at or past the next
+        # node (one gather of (first, next node) and a compare instead of a binary search)
         th = theta.detach()
-        i = start[((th - z0) * inv_w).long().clamp(0, start.numel() - 1)]
-        i = i + (th >= z[i + 1]).long()
-        i = i.clamp(max=z.numel() - 2)
+        sb = bucket[((th - z0) * inv_w).long().clamp_(0, bucket.shape[0] - 1)]
+        i = (sb[..., 0] + (th >= sb[..., 1]).to(th.dtype)).long().clamp_(max=z.numel() - 2)
+        if coef is not None:
+            c = coef[i]  # one gather of the interval's start, 1/width and four coefficients
+            t = (theta - c[..., 0]) * c[..., 1]
+            return c[..., 2] + t * (c[..., 3] + t * (c[..., 4] + t * c[..., 5]))
         x0 = z[i]
         h = z[i + 1] - x0
         t = (theta - x0) / h
-        if coef is not None:
-            c = coef[i]  # one gather of the interval's four coefficients
-            return c[..., 0] + t * (c[..., 1] + t * (c[..., 2] + t * c[..., 3]))
         lead = torch.broadcast_shapes(r.shape[:-1], i.shape[:-1])
         rb = r.expand(*lead, r.shape[-1])
         db = d.expand(*lead, d.shape[-1])
