@@ -35,6 +35,7 @@ import torch
 import torch.nn.functional as F
 from kornia.geometry.camera import PinholeCamera
 
+from ._parallel import map_chunks
 from ._validation import check_finite_range, per_batch
 from .expectation import Quadrature, _reflection_terms, apparent_radiance
 from .geometry import EARTH_RADIUS_M, CameraGeometry, ViewGeometry, view_geometry
@@ -684,60 +685,25 @@ def _render_table(
         xp_t = torch.as_tensor(xp, dtype=torch.float64, device=device)
         ph_nodes = (c[:, None] - shift + a[:, None] + (b - a)[:, None] * (xp_t + 1) / 2).to(dtype)
 
-    # ---- the model at the nodes -----------------------------------------------------------------
-    vz = th_nodes[:, :, None].expand(B, nz, nphi)
-    va = ph_nodes[:, None, :].expand(B, nz, nphi)
-    slopes = SlopeStatistics.from_variances(p["vx"][:, None, None], p["vy"][:, None, None], p["cxy"][:, None, None])
-    sky = _sky_per_image(p["sky"], B, dtype, device, 2)
-    # T_s, T_ρ in the model's working dtype: float64 without shadowing, where they grow like
-    # σ∥/cos θ̂ and R_B (1 − T_ρ) + T_s cancels them (expectation._work_dtype)
-    t_s, t_rho, _ = _reflection_terms(vz, va, slopes, (p["n"][:, None, None], p["k"][:, None, None]), sky, scene.shadowing, q, None)
-    if p["air_scale"] is not None:
-        t_s = t_s * p["air_scale"][:, None, None].to(t_s.dtype)
-    rb = p["rb"][:, None, None].to(t_s.dtype)
-    coarse = (rb - rb * t_rho + t_s).to(dtype)  # R_a at the nodes (B, nz, nphi)
-
-    # ---- the fine tables' row matrix A = [τ L_z | L_path ; 0 | sky] (B, M_z + M_s, nz + 1) -------
+    # ---- per-image constants of the fine tables and of the pixels' table coordinates ------------
+    # Fine table of an image: rows 0 … M_z − 1 at ζ = lo + span (y_z + 1)/2 (y_z evenly spaced,
+    # overhanging [−1, 1] by _EXT rows), rows M_z … M_z + M_s − 1 at cos = s0 + j ds; row r is read
+    # at gy = 2 r / (N − 1) − 1.
     Mz, Ms = table.fine_zenith, table.fine_sky
-    Lz_t = torch.as_tensor(Lz, dtype=dtype, device=device)
+    N = Mz + Ms
     span_z = hi - lo
-    y_z = torch.linspace(-1.0 - ez, 1.0 + ez, Mz, dtype=torch.float64, device=device)
     if scene.path is not None:
         _check_path_altitude(scene.path, altitude)
-        zeta_rows = lo[:, None] + span_z[:, None] * (y_z + 1) / 2  # (B, M_z)
-        cos_rows = (eps[:, None] * torch.sinh(zeta_rows)).clamp(0.0, 1.0).to(dtype)
-        h = altitude.to(dtype)[:, None]
-        tau, l_path = scene.path(h.expand_as(cos_rows), _slant_range(cos_rows, h, earth_radius_m), clamp=True)
-        if p["air_scale"] is not None:
-            l_path = l_path * p["air_scale"][:, None].to(dtype)
-        a_sea = torch.cat([tau[:, :, None] * Lz_t, l_path[:, :, None].to(dtype)], -1)
-    else:
-        a_sea = torch.cat([Lz_t, torch.zeros(Mz, 1, dtype=dtype, device=device)], -1).expand(B, Mz, nz + 1)
     es = 2.0 * _EXT / (Ms - 1 - 2 * _EXT)
     s_lo, s_hi = (torch.where(rg.any_sky, v, torch.full_like(v, d)) for v, d in zip(rg.sky, (0.0, 1.0)))
     s_pad = torch.clamp(1e-6 * (s_hi - s_lo), min=1e-7)
     s_lo, s_hi = s_lo - s_pad, s_hi + s_pad
-    # rows s0 + j ds, j = 0 … M_s − 1, overhanging the span by _EXT rows; a ray at the horizontal
-    # (cos = 0, where a sea-level sky is held constant below, a kink) falls on a row
+    # a ray at the horizontal (cos = 0, where a sea-level sky is held constant below: a kink) falls
+    # on a row
     ds = (s_hi - s_lo) * (1.0 + es) / (Ms - 1)
     s0 = s_lo - _EXT * ds
     r0 = -s0 / ds
     s0 = torch.where((r0 > 0) & (r0 < Ms - 1), s0 - (torch.ceil(r0) - r0) * ds, s0)
-    s_rows = (s0[:, None] + ds[:, None] * torch.arange(Ms, dtype=torch.float64, device=device)).to(dtype)
-    if bool(rg.any_sky.any()):
-        sky_rows = _sky_rows(p, scene, s_rows, altitude).to(dtype)
-    else:  # no sky work when no pixel sees sky
-        sky_rows = torch.zeros_like(s_rows)
-    a_sky = torch.cat([torch.zeros(B, Ms, nz, dtype=dtype, device=device), sky_rows[:, :, None]], -1)
-    A = torch.cat([a_sea, a_sky], 1)
-    C = torch.cat([coarse, torch.ones(B, 1, nphi, dtype=dtype, device=device)], 1)  # (B, nz + 1, nphi)
-    Lp_t = None if iso else torch.as_tensor(Lp, dtype=dtype, device=device)
-    per_table = brightness and (Mz + Ms) * (1 if iso else table.fine_azimuth) < H * W  # kelvin per table row
-
-    # ---- per pixel: table coordinates, one grid_sample ------------------------------------------
-    # row r of the fine table ↔ gy = 2 r / (N − 1) − 1; sea rows at ζ = lo + span (y_z + 1)/2,
-    # sky rows at cos = s_lo + span_s (y_s + 1)/2 (both y evenly spaced, overhanging by _EXT rows)
-    N = Mz + Ms
     k_sea = (2.0 / (N - 1)) * (Mz - 1) / (span_z * (1.0 + ez))  # dgy/dζ
     b_sea = -1.0 - k_sea * (lo - ez * span_z / 2)
     k_sky = (2.0 / (N - 1)) / ds
@@ -748,11 +714,54 @@ def _render_table(
         b_az = ((-2.0 * a / (b - a) - 1.0) / (1.0 + ep)).to(dtype)
         az_offset = (math.pi / 2 - rg.centre - wd.double()).to(dtype) if not fold else (math.pi / 2 - wd).to(dtype)
     if cg is not None:
-        zeta_scale = (inv_eps if cg.flat else cg.k_r.to(dtype) * inv_eps)
-    out: torch.Tensor | None = None
-    for i in range(0, B, chunk):
-        sl = slice(i, min(i + chunk, B))
+        zeta_scale = inv_eps if cg.flat else cg.k_r.to(dtype) * inv_eps
+    Lz_t = torch.as_tensor(Lz, dtype=dtype, device=device)
+    Lp_t = None if iso else torch.as_tensor(Lp, dtype=dtype, device=device)
+    y_z = torch.linspace(-1.0 - ez, 1.0 + ez, Mz, dtype=torch.float64, device=device)
+    per_table = brightness and N * (1 if iso else table.fine_azimuth) < H * W  # kelvin per table row
+
+    def one(sl: slice) -> torch.Tensor:
+        """Images ``sl``: the model at their nodes, their fine tables, their pixels; (b, H, W)."""
+        b_ = sl.stop - sl.start
+        # the model at the nodes; T_s, T_ρ in its working dtype: float64 without shadowing, where
+        # they grow like σ∥/cos θ̂ and R_B (1 − T_ρ) + T_s cancels them (expectation._work_dtype)
+        vz = th_nodes[sl, :, None].expand(b_, nz, nphi)
+        va = ph_nodes[sl, None, :].expand(b_, nz, nphi)
+        slopes = SlopeStatistics.from_variances(p["vx"][sl, None, None], p["vy"][sl, None, None], p["cxy"][sl, None, None])
+        sky = _sky_per_image(select_sky(p["sky"], sl), b_, dtype, device, 2)
+        t_s, t_rho, _ = _reflection_terms(vz, va, slopes, (p["n"][sl, None, None], p["k"][sl, None, None]), sky,
+                                          scene.shadowing, q, None)
+        if p["air_scale"] is not None:
+            t_s = t_s * p["air_scale"][sl, None, None].to(t_s.dtype)
+        rb = p["rb"][sl, None, None].to(t_s.dtype)
+        coarse = (rb - rb * t_rho + t_s).to(dtype)  # R_a at the nodes (b, nz, nphi)
+
+        # the fine tables: sea rows [τ L_z | L_path] · [R_a ; 1] · L_oᵀ, sky rows the sky
+        if scene.path is not None:
+            cos_rows = (eps[sl, None] * torch.sinh(lo[sl, None] + span_z[sl, None] * (y_z + 1) / 2)).clamp(0.0, 1.0).to(dtype)
+            h = altitude[sl].to(dtype)[:, None]
+            tau, l_path = scene.path(h.expand_as(cos_rows), _slant_range(cos_rows, h, earth_radius_m), clamp=True)
+            if p["air_scale"] is not None:
+                l_path = l_path * p["air_scale"][sl, None].to(dtype)
+            sea_rows = torch.cat([tau[:, :, None] * Lz_t, l_path[:, :, None].to(dtype)], -1) @ torch.cat(
+                [coarse, torch.ones(b_, 1, nphi, dtype=dtype, device=device)], 1)
+        else:
+            sea_rows = Lz_t @ coarse  # (b, M_z, nphi)
         has_sky = bool(rg.any_sky[sl].any())
+        if has_sky:
+            s_rows = (s0[sl, None] + ds[sl, None] * torch.arange(Ms, dtype=torch.float64, device=device)).to(dtype)
+            sky_rows = _sky_rows(_scene_rows(p, sl), scene, s_rows, altitude[sl]).to(dtype)
+        else:  # no sky work when no pixel sees sky
+            sky_rows = torch.zeros(b_, Ms, dtype=dtype, device=device)
+        if Lp_t is None:
+            fine = torch.cat([sea_rows, sky_rows[:, :, None]], 1)  # (b, N, 1)
+        else:  # sea rows resampled in azimuth; sky rows repeated (not through L_o, whose overhang
+            # rows sum to 1 only to rounding: sky pixels may read the border columns)
+            fine = torch.cat([sea_rows @ Lp_t.T, sky_rows[:, :, None].expand(-1, -1, Lp_t.shape[0])], 1)
+        if per_table:
+            fine = brightness_temperature(fine.clamp_min(torch.finfo(dtype).tiny), scene.band)
+
+        # per pixel: the table coordinates, one grid_sample
         if geometry is not None:
             cos, sea = geometry.cos_view_zenith[sl], geometry.is_sea[sl]
             dx, dy = geometry._dx[sl], geometry._dy[sl]
@@ -764,8 +773,8 @@ def _render_table(
             # q = (cos θ̂/ε)² = c1² (dz² − s_h²); sky pixels (unused) and the horizon row are held at
             # a tiny q > 0, which keeps √'s gradient finite
             sea = cos < -sh
-            q = torch.addcmul(-(c1 * sh) ** 2, cos, cos * (c1 * c1)).clamp_min(1e-30)
-            zeta = torch.log(torch.sqrt(q) + torch.sqrt(q + 1.0))
+            q_ = torch.addcmul(-(c1 * sh) ** 2, cos, cos * (c1 * c1)).clamp_min(1e-30)
+            zeta = torch.log(torch.sqrt(q_) + torch.sqrt(q_ + 1.0))
         gy = torch.addcmul(b_sea[sl, None, None], zeta, k_sea[sl, None, None])
         if has_sky:  # cos: the sky pixels' cos of the ray's zenith (dz)
             gy = torch.where(sea, gy, torch.addcmul(b_sky[sl, None, None], cos, k_sky[sl, None, None]))
@@ -774,25 +783,21 @@ def _render_table(
         else:
             o = _azimuth_coordinate(dx, dy, az_offset[sl], fold)
             gx = torch.addcmul(b_az[sl, None, None], o, k_az[sl, None, None])
-        if Lp_t is None:
-            fine = A[sl] @ C[sl]  # (b, N, 1)
-        else:  # the sea rows resampled in azimuth; sky rows repeated (not through L_o: its overhang
-            # rows sum to 1 only to rounding, and sky pixels may read the border columns)
-            fine = torch.cat([(A[sl, :Mz] @ C[sl]) @ Lp_t.T, sky_rows[sl, :, None].expand(-1, -1, Lp_t.shape[0])], 1)
-        if per_table:
-            fine = brightness_temperature(fine.clamp_min(torch.finfo(dtype).tiny), scene.band)
         # bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges
         # only to first order; bilinear on the fine table is second order (~1e-7 at 4096 rows).
         vals = F.grid_sample(fine[:, None], torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border",
                              align_corners=True)[:, 0]
         if brightness and not per_table:
             vals = brightness_temperature(vals.clamp_min(torch.finfo(dtype).tiny), scene.band)
-        if sl.stop - sl.start == B:
-            return vals
-        if out is None:
-            out = torch.empty(B, H, W, dtype=vals.dtype, device=device)
-        out[sl] = vals  # chunks land in place (autograd records the slice copies)
-    return out
+        return vals
+
+    parts = map_chunks(one, [slice(i, min(i + chunk, B)) for i in range(0, B, chunk)], device)
+    return parts[0] if len(parts) == 1 else torch.cat(parts)
+
+
+def _scene_rows(p: dict[str, Any], sl: slice) -> dict[str, Any]:
+    """The resolved scene ``p`` of images ``sl`` as far as :func:`_sky_rows` needs it."""
+    return dict(sky=select_sky(p["sky"], sl), air_scale=None if p["air_scale"] is None else p["air_scale"][sl])
 
 
 class SeaRenderer(torch.nn.Module):

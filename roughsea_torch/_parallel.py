@@ -1,0 +1,68 @@
+"""Coarse-grained parallelism over independent chunks of work (images, groups of views).
+
+Why not torch's own intra-op parallelism alone: every large torch operation on the CPU is an
+OpenMP parallel region whose threads wait for each other at its end. When the cores are shared (a
+data loader, another job, the normal case in training), a descheduled thread stalls every region,
+and a renderer made of hundreds of operations ran up to 10× slower on 2 threads than on 1
+(``pipelines/bench_render.py``). Setting ``OMP_WAIT_POLICY=PASSIVE`` before torch starts softens
+this, but a library cannot count on it. Here independent chunks run on worker threads with one
+intra-op thread each, so no operation waits for another thread: a slow thread delays only its own
+chunks. The chunks are the same whatever the thread count, so results do not depend on it.
+
+Used only on the CPU, with torch's OpenMP backend, when ``torch.get_num_threads() > 1`` and there
+are at least two chunks; otherwise the chunks run in order on the calling thread. The workers take
+the caller's autograd mode. ``torch.set_num_threads`` is per thread under OpenMP (a worker's
+setting does not change the caller's); while a call runs, a thread that starts using torch for the
+first time may take the workers' setting of 1 (torch keeps the last value set as the default for
+new threads), which the workers restore when their chunk ends.
+"""
+
+from __future__ import annotations
+
+import threading
+from concurrent.futures import ThreadPoolExecutor
+from functools import lru_cache
+from typing import Any, Callable, Sequence, TypeVar
+
+import torch
+
+__all__ = ["map_chunks"]
+
+T = TypeVar("T")
+_local = threading.local()
+_lock = threading.Lock()
+_pools: dict[int, ThreadPoolExecutor] = {}
+
+
+@lru_cache(maxsize=1)
+def _openmp_backend() -> bool:
+    return "ATen parallel backend: OpenMP" in torch.__config__.parallel_info()
+
+
+def _pool(n: int) -> ThreadPoolExecutor:
+    with _lock:
+        if n not in _pools:
+            _pools[n] = ThreadPoolExecutor(n, thread_name_prefix="roughsea")
+        return _pools[n]
+
+
+def map_chunks(fn: Callable[[Any], T], items: Sequence[Any], device: torch.device | str | None) -> list[T]:
+    """``[fn(x) for x in items]``, the items spread over ``torch.get_num_threads()`` worker threads
+    of one intra-op thread each (see the module docstring for when and why)."""
+    n = torch.get_num_threads()
+    dev = torch.device(device) if device is not None else torch.device("cpu")
+    if dev.type != "cpu" or n <= 1 or len(items) <= 1 or getattr(_local, "worker", False) or not _openmp_backend():
+        return [fn(x) for x in items]
+    grad, inference = torch.is_grad_enabled(), torch.is_inference_mode_enabled()
+
+    def run(x: Any) -> T:
+        _local.worker = True
+        torch.set_num_threads(1)
+        try:
+            with torch.inference_mode(inference), torch.set_grad_enabled(grad):
+                return fn(x)
+        finally:
+            torch.set_num_threads(n)
+            _local.worker = False
+
+    return list(_pool(n).map(run, items))
