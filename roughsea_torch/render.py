@@ -72,8 +72,11 @@ class SeaScene:
             or an ``AtmosphericPath``: on. On by default because it matters at every range a sea
             scene spans: LWIR midlatitude summer from 20 m, τ = 0.95 at 100 m, 0.75 at 1 km, 0.05 at
             the 16 km horizon, shifting a 290 K sea by +0.2 K, +1.1 K, +4.0 K (more than a typical
-            NETD of 0.05 K beyond ~20 m). Sky pixels see the sky table along their own ray (from
-            sea level: for a high sensor the sky above it is somewhat colder; not modelled).
+            NETD of 0.05 K beyond ~20 m). With the path on, sky pixels see the sky from the camera's
+            altitude (``roughsea_torch.atmosphere.load_observer_sky``): rays just above the
+            depressed horizon cross the same ~16 km of surface air (from 20 m) as the sea's horizon
+            row, so the image is continuous across the horizon; with it off, the sky seen from sea
+            level along their ray.
         air_temperature: T_air [K] of the surface air, float or (B,); only with a named atmosphere
             (default ``None``: the atmosphere's own, e.g. 294.2 K for midlatitude summer). The
             atmosphere's temperature profile is taken as shifted so that its surface air is at
@@ -145,8 +148,14 @@ class SeaScene:
         if path is not False and not callable(path):
             raise ValueError(f"path must be None, a bool, an atmosphere name or an AtmosphericPath; got {path!r}")
         self.path = path or None
-        # sky pixels of a named atmosphere with its path on: the sky seen from the camera's altitude
+        # sky pixels of a named atmosphere with its own path on: the sky seen from the camera's
+        # altitude, continuous with the sea's horizon row (rays between the horizon dip and the
+        # horizontal cross the same lowest air); otherwise the sky seen from sea level
         self.observer_sky = None
+        if self.atmosphere is not None and self.path is not None and getattr(self.path, "name", None) == self.atmosphere:
+            from .atmosphere import load_observer_sky
+
+            self.observer_sky = load_observer_sky(self.atmosphere, self.band, dtype=torch.float64)
         if air_temperature is not None:
             if self.atmosphere is None:
                 raise ValueError("air_temperature needs a named atmosphere (sky='<name>'); scale a custom sky yourself")
@@ -398,8 +407,8 @@ def _asinh(x: torch.Tensor) -> torch.Tensor:
     return torch.log(x + torch.sqrt(x * x + 1.0))  # 3× faster than torch.asinh on CPU
 
 
-def _camera_ranges(cg: CameraGeometry, wd: torch.Tensor, inv_eps: torch.Tensor, iso: bool, fold: bool) -> _Ranges:
-    """The spans of an image from the rays of its border alone (no per-pixel work).
+def _camera_ranges(cg: CameraGeometry, sl: slice, wd: torch.Tensor, inv_eps: torch.Tensor, iso: bool, fold: bool) -> _Ranges:
+    """The spans of the images ``sl`` from the rays of their border alone (no per-pixel work).
 
     cos θ̂ of a sea pixel grows with −dz (the ray's local-vertical component), and dz and the LOS
     azimuth are smooth functions of the ray whose only critical points are the nadir and the zenith:
@@ -409,11 +418,11 @@ def _camera_ranges(cg: CameraGeometry, wd: torch.Tensor, inv_eps: torch.Tensor, 
     against the continuous one).
     """
     with torch.no_grad():
-        dz, dx, dy = (t.double() for t in cg.border())
-        nadir, zenith = cg.poles_in_view()
+        dz, dx, dy = (t.double() for t in cg.border(sl))
+        nadir, zenith = cg.poles_in_view(sl)
         B = dz.shape[0]
-        sh = torch.zeros(B, dtype=torch.float64, device=dz.device) if cg.flat else cg.s_h.double()
-        kr = torch.ones_like(sh) if cg.flat else cg.k_r.double()
+        sh = torch.zeros(B, dtype=torch.float64, device=dz.device) if cg.flat else cg.s_h[sl].double()
+        kr = torch.ones_like(sh) if cg.flat else cg.k_r[sl].double()
         dz_min = torch.where(nadir, -torch.ones_like(sh), dz.amin(1))
         dz_max = torch.where(zenith, torch.ones_like(sh), dz.amax(1))
         any_sea = -dz_min > sh
@@ -451,17 +460,17 @@ def _camera_ranges(cg: CameraGeometry, wd: torch.Tensor, inv_eps: torch.Tensor, 
         return _Ranges((z_lo, z_hi), (s_lo, s_hi), any_sea, any_sky, (lo, hi), c)
 
 
-def _geometry_ranges(g: ViewGeometry, wd: torch.Tensor, inv_eps: torch.Tensor, iso: bool, fold: bool) -> _Ranges:
-    """The spans of an image from a precomputed per-pixel :class:`ViewGeometry`."""
+def _geometry_ranges(g: ViewGeometry, sl: slice, wd: torch.Tensor, inv_eps: torch.Tensor, iso: bool, fold: bool) -> _Ranges:
+    """The spans of the images ``sl`` from a precomputed per-pixel :class:`ViewGeometry`."""
     with torch.no_grad():
-        sea = g.is_sea
+        sea, cos, dx, dy = g.is_sea[sl], g.cos_view_zenith[sl], g._dx[sl], g._dy[sl]
         any_sea, any_sky = sea.flatten(1).any(1), (~sea).flatten(1).any(1)
-        z = _masked_range(_asinh(g.cos_view_zenith.clamp_min(0.0) * inv_eps[:, None, None]), sea)
-        s = _masked_range(g.cos_view_zenith, ~sea)
+        z = _masked_range(_asinh(cos.clamp_min(0.0) * inv_eps[:, None, None]), sea)
+        s = _masked_range(cos, ~sea)
         out = _Ranges(tuple(v.double() for v in z), tuple(v.double() for v in s), any_sea, any_sky)
         if not iso:
-            c = torch.zeros_like(wd) if fold else _azimuth_centre(g._dx, g._dy, wd, sea)
-            o = _azimuth_coordinate(g._dx, g._dy, math.pi / 2 - c - wd, fold)
+            c = torch.zeros_like(wd) if fold else _azimuth_centre(dx, dy, wd, sea)
+            o = _azimuth_coordinate(dx, dy, math.pi / 2 - c - wd, fold)
             out.azimuth = tuple(v.double() for v in _masked_range(o, sea))
             out.centre = c.double()
         return out
@@ -636,9 +645,10 @@ def _render_table(
     - rows M_z … M_z + M_s − 1 (the sky): the sky radiance over the cosine of the ray's zenith at
       the camera, constant along o.
 
-    Spans come from the image's border (:func:`_camera_ranges`) or from a given ``geometry``; the
-    model runs once for the batch; pixels are then visited ``chunk`` images at a time, once each.
-    With ``brightness`` the result is in kelvin. Returns (B, H, W).
+    Spans come from the image's border (:func:`_camera_ranges`) or from a given ``geometry``. Images
+    are processed ``chunk`` at a time, start to end (spans, model at the nodes, tables, pixels), the
+    chunks spread over worker threads by :func:`~roughsea_torch._parallel.map_chunks`. With
+    ``brightness`` the result is in kelvin. Returns (B, H, W).
     """
     iso = bool(((p["vx"] == p["vy"]) & (p["cxy"] == 0)).all())
     # Uncorrelated anisotropic slopes (Cox–Munk): the table runs over the folded azimuth ψ ∈ [0, π/2].
@@ -655,78 +665,55 @@ def _render_table(
     thin = bool((lam_min.detach() < 0.04 * lam_max.detach()).any())  # minor/major rms slope < 0.2
     nz = max(table.zenith, table.zenith_thin) if thin else table.zenith
     nphi = 1 if iso else max(table.azimuth, table.azimuth_thin) if thin else table.azimuth
-    wd = p["wind_direction"]
-    rg = (_geometry_ranges(geometry, wd, inv_eps, iso, fold) if geometry is not None
-          else _camera_ranges(cg, wd, inv_eps, iso, fold))
-
-    # ---- node spans (float64) -------------------------------------------------------------------
-    lo, hi = (torch.where(rg.any_sea, v, torch.full_like(v, d)) for v, d in zip(rg.zeta, (0.0, 1.0)))
-    if table.span == "full":
-        lo, hi = torch.zeros_like(lo), torch.asinh(1.0 / eps)
-    pad = torch.clamp(1e-6 * (hi - lo), min=1e-9)
-    lo, hi = lo - pad, hi + pad
     xz, Lz, ez = _lobatto_interp(nz, table.fine_zenith)
-    zeta_n = lo[:, None] + (hi - lo)[:, None] * (torch.as_tensor(xz, dtype=torch.float64, device=device) + 1) / 2
-    th_nodes = torch.acos((eps[:, None] * torch.sinh(zeta_n)).clamp(0.0, 1.0)).to(dtype)  # (B, nz)
-    if iso:
-        ph_nodes = torch.zeros(B, 1, dtype=dtype, device=device)
-    else:
-        a, b = (torch.where(rg.any_sea, v, torch.full_like(v, d)) for v, d in zip(rg.azimuth, (0.0, 1.0)))
-        c = rg.centre
-        if table.span == "full":
-            a, b = torch.zeros_like(a), torch.full_like(b, math.pi / 2 if fold else math.pi)
-        pad = torch.clamp(1e-6 * (b - a), min=1e-6)
-        a, b = a - pad, b + pad
-        if fold:  # ψ ∈ [0, π/2]: keep the nodes inside it (the kink stays at the interval's end)
-            a, b = a.clamp_min(0.0), b.clamp_max(math.pi / 2)
+    xz_t = torch.as_tensor(xz, dtype=torch.float64, device=device)
+    Lz_t = torch.as_tensor(Lz, dtype=dtype, device=device)
+    if not iso:
         xp, Lp, ep = _lobatto_interp(nphi, table.fine_azimuth)
-        # the pixels' o = wrap_π(φ̂ − c) + π/2: nodes at φ̂ = c + o − π/2 (folded: φ̂ = o = ψ)
-        shift = 0.0 if fold else math.pi / 2
         xp_t = torch.as_tensor(xp, dtype=torch.float64, device=device)
-        ph_nodes = (c[:, None] - shift + a[:, None] + (b - a)[:, None] * (xp_t + 1) / 2).to(dtype)
-
-    # ---- per-image constants of the fine tables and of the pixels' table coordinates ------------
-    # Fine table of an image: rows 0 … M_z − 1 at ζ = lo + span (y_z + 1)/2 (y_z evenly spaced,
-    # overhanging [−1, 1] by _EXT rows), rows M_z … M_z + M_s − 1 at cos = s0 + j ds; row r is read
-    # at gy = 2 r / (N − 1) − 1.
+        Lp_t = torch.as_tensor(Lp, dtype=dtype, device=device)
     Mz, Ms = table.fine_zenith, table.fine_sky
     N = Mz + Ms
-    span_z = hi - lo
-    if scene.path is not None:
-        _check_path_altitude(scene.path, altitude)
     es = 2.0 * _EXT / (Ms - 1 - 2 * _EXT)
-    s_lo, s_hi = (torch.where(rg.any_sky, v, torch.full_like(v, d)) for v, d in zip(rg.sky, (0.0, 1.0)))
-    s_pad = torch.clamp(1e-6 * (s_hi - s_lo), min=1e-7)
-    s_lo, s_hi = s_lo - s_pad, s_hi + s_pad
-    # a ray at the horizontal (cos = 0, where a sea-level sky is held constant below: a kink) falls
-    # on a row
-    ds = (s_hi - s_lo) * (1.0 + es) / (Ms - 1)
-    s0 = s_lo - _EXT * ds
-    r0 = -s0 / ds
-    s0 = torch.where((r0 > 0) & (r0 < Ms - 1), s0 - (torch.ceil(r0) - r0) * ds, s0)
-    k_sea = (2.0 / (N - 1)) * (Mz - 1) / (span_z * (1.0 + ez))  # dgy/dζ
-    b_sea = -1.0 - k_sea * (lo - ez * span_z / 2)
-    k_sky = (2.0 / (N - 1)) / ds
-    b_sky = 2.0 * Mz / (N - 1) - 1.0 - k_sky * s0
-    k_sea, b_sea, k_sky, b_sky = (v.to(dtype) for v in (k_sea, b_sea, k_sky, b_sky))
-    if not iso:
-        k_az = (2.0 / ((b - a) * (1.0 + ep))).to(dtype)
-        b_az = ((-2.0 * a / (b - a) - 1.0) / (1.0 + ep)).to(dtype)
-        az_offset = (math.pi / 2 - rg.centre - wd.double()).to(dtype) if not fold else (math.pi / 2 - wd).to(dtype)
-    if cg is not None:
-        zeta_scale = inv_eps if cg.flat else cg.k_r.to(dtype) * inv_eps
-    Lz_t = torch.as_tensor(Lz, dtype=dtype, device=device)
-    Lp_t = None if iso else torch.as_tensor(Lp, dtype=dtype, device=device)
     y_z = torch.linspace(-1.0 - ez, 1.0 + ez, Mz, dtype=torch.float64, device=device)
     per_table = brightness and N * (1 if iso else table.fine_azimuth) < H * W  # kelvin per table row
+    if scene.path is not None:
+        _check_path_altitude(scene.path, altitude)
 
     def one(sl: slice) -> torch.Tensor:
-        """Images ``sl``: the model at their nodes, their fine tables, their pixels; (b, H, W)."""
+        """Images ``sl``, start to end: spans, the model at the nodes, the fine tables, the pixels;
+        (b, H, W). Everything here is per image, so chunks run independently (``map_chunks``)."""
         b_ = sl.stop - sl.start
-        # the model at the nodes; T_s, T_ρ in its working dtype: float64 without shadowing, where
-        # they grow like σ∥/cos θ̂ and R_B (1 − T_ρ) + T_s cancels them (expectation._work_dtype)
-        vz = th_nodes[sl, :, None].expand(b_, nz, nphi)
-        va = ph_nodes[sl, None, :].expand(b_, nz, nphi)
+        wd = p["wind_direction"][sl]
+        rg = (_geometry_ranges(geometry, sl, wd, inv_eps[sl], iso, fold) if geometry is not None
+              else _camera_ranges(cg, sl, wd, inv_eps[sl], iso, fold))
+
+        # ---- node spans (float64) -----------------------------------------------------------------
+        lo, hi = (torch.where(rg.any_sea, v, torch.full_like(v, d)) for v, d in zip(rg.zeta, (0.0, 1.0)))
+        if table.span == "full":
+            lo, hi = torch.zeros_like(lo), torch.asinh(1.0 / eps[sl])
+        pad = torch.clamp(1e-6 * (hi - lo), min=1e-9)
+        lo, hi = lo - pad, hi + pad
+        span_z = hi - lo
+        th_nodes = torch.acos((eps[sl, None] * torch.sinh(lo[:, None] + span_z[:, None] * (xz_t + 1) / 2)).clamp(0.0, 1.0))
+        if iso:
+            ph_nodes = torch.zeros(b_, 1, dtype=dtype, device=device)
+        else:
+            a, b = (torch.where(rg.any_sea, v, torch.full_like(v, d)) for v, d in zip(rg.azimuth, (0.0, 1.0)))
+            if table.span == "full":
+                a, b = torch.zeros_like(a), torch.full_like(b, math.pi / 2 if fold else math.pi)
+            pad = torch.clamp(1e-6 * (b - a), min=1e-6)
+            a, b = a - pad, b + pad
+            if fold:  # ψ ∈ [0, π/2]: keep the nodes inside it (the kink stays at the interval's end)
+                a, b = a.clamp_min(0.0), b.clamp_max(math.pi / 2)
+            # the pixels' o = wrap_π(φ̂ − c) + π/2: nodes at φ̂ = c + o − π/2 (folded: φ̂ = o = ψ)
+            shift = 0.0 if fold else math.pi / 2
+            ph_nodes = (rg.centre[:, None] - shift + a[:, None] + (b - a)[:, None] * (xp_t + 1) / 2).to(dtype)
+
+        # ---- the model at the nodes; T_s, T_ρ in its working dtype: float64 without shadowing,
+        # where they grow like σ∥/cos θ̂ and R_B (1 − T_ρ) + T_s cancels them (expectation._work_dtype)
+        vz = th_nodes.to(dtype)[:, :, None].expand(b_, nz, nphi)
+        va = ph_nodes[:, None, :].expand(b_, nz, nphi)
         slopes = SlopeStatistics.from_variances(p["vx"][sl, None, None], p["vy"][sl, None, None], p["cxy"][sl, None, None])
         sky = _sky_per_image(select_sky(p["sky"], sl), b_, dtype, device, 2)
         t_s, t_rho, _ = _reflection_terms(vz, va, slopes, (p["n"][sl, None, None], p["k"][sl, None, None]), sky,
@@ -736,9 +723,11 @@ def _render_table(
         rb = p["rb"][sl, None, None].to(t_s.dtype)
         coarse = (rb - rb * t_rho + t_s).to(dtype)  # R_a at the nodes (b, nz, nphi)
 
-        # the fine tables: sea rows [τ L_z | L_path] · [R_a ; 1] · L_oᵀ, sky rows the sky
+        # ---- the fine tables: sea rows [τ L_z | L_path] · [R_a ; 1] · L_oᵀ at ζ = lo + span (y_z + 1)/2,
+        # sky rows at cos = s0 + j ds (a ray at the horizontal, cos = 0, where a sea-level sky is
+        # held constant below, a kink, falls on a row); row r is read at gy = 2 r / (N − 1) − 1
         if scene.path is not None:
-            cos_rows = (eps[sl, None] * torch.sinh(lo[sl, None] + span_z[sl, None] * (y_z + 1) / 2)).clamp(0.0, 1.0).to(dtype)
+            cos_rows = (eps[sl, None] * torch.sinh(lo[:, None] + span_z[:, None] * (y_z + 1) / 2)).clamp(0.0, 1.0).to(dtype)
             h = altitude[sl].to(dtype)[:, None]
             tau, l_path = scene.path(h.expand_as(cos_rows), _slant_range(cos_rows, h, earth_radius_m), clamp=True)
             if p["air_scale"] is not None:
@@ -747,13 +736,20 @@ def _render_table(
                 [coarse, torch.ones(b_, 1, nphi, dtype=dtype, device=device)], 1)
         else:
             sea_rows = Lz_t @ coarse  # (b, M_z, nphi)
-        has_sky = bool(rg.any_sky[sl].any())
+        s_lo, s_hi = (torch.where(rg.any_sky, v, torch.full_like(v, d)) for v, d in zip(rg.sky, (0.0, 1.0)))
+        s_pad = torch.clamp(1e-6 * (s_hi - s_lo), min=1e-7)
+        s_lo, s_hi = s_lo - s_pad, s_hi + s_pad
+        ds = (s_hi - s_lo) * (1.0 + es) / (Ms - 1)
+        s0 = s_lo - _EXT * ds
+        r0 = -s0 / ds
+        s0 = torch.where((r0 > 0) & (r0 < Ms - 1), s0 - (torch.ceil(r0) - r0) * ds, s0)
+        has_sky = bool(rg.any_sky.any())
         if has_sky:
-            s_rows = (s0[sl, None] + ds[sl, None] * torch.arange(Ms, dtype=torch.float64, device=device)).to(dtype)
+            s_rows = (s0[:, None] + ds[:, None] * torch.arange(Ms, dtype=torch.float64, device=device)).to(dtype)
             sky_rows = _sky_rows(_scene_rows(p, sl), scene, s_rows, altitude[sl]).to(dtype)
         else:  # no sky work when no pixel sees sky
             sky_rows = torch.zeros(b_, Ms, dtype=dtype, device=device)
-        if Lp_t is None:
+        if iso:
             fine = torch.cat([sea_rows, sky_rows[:, :, None]], 1)  # (b, N, 1)
         else:  # sea rows resampled in azimuth; sky rows repeated (not through L_o, whose overhang
             # rows sum to 1 only to rounding: sky pixels may read the border columns)
@@ -761,28 +757,35 @@ def _render_table(
         if per_table:
             fine = brightness_temperature(fine.clamp_min(torch.finfo(dtype).tiny), scene.band)
 
-        # per pixel: the table coordinates, one grid_sample
+        # ---- per pixel: the table coordinates, one grid_sample
+        k_sea = (2.0 / (N - 1)) * (Mz - 1) / (span_z * (1.0 + ez))  # dgy/dζ
+        b_sea = -1.0 - k_sea * (lo - ez * span_z / 2)
+        k_sky = (2.0 / (N - 1)) / ds
+        b_sky = 2.0 * Mz / (N - 1) - 1.0 - k_sky * s0
+        k_sea, b_sea, k_sky, b_sky = (v.to(dtype)[:, None, None] for v in (k_sea, b_sea, k_sky, b_sky))
         if geometry is not None:
             cos, sea = geometry.cos_view_zenith[sl], geometry.is_sea[sl]
             dx, dy = geometry._dx[sl], geometry._dy[sl]
             zeta = _asinh((cos * inv_eps[sl, None, None]).clamp_min(0.0))
         else:  # ζ straight from the ray's vertical component dz: cos θ̂ / ε = (k_r/ε) √((dz + s_h)(dz − s_h))
             cos, dx, dy = cg.ray_components(sl, need_xy=not iso)
-            c1 = zeta_scale[sl, None, None]
+            c1 = (inv_eps[sl] if cg.flat else cg.k_r[sl].to(dtype) * inv_eps[sl])[:, None, None]
             sh = cg.s_h[sl, None, None] if not cg.flat else torch.zeros_like(c1)
             # q = (cos θ̂/ε)² = c1² (dz² − s_h²); sky pixels (unused) and the horizon row are held at
             # a tiny q > 0, which keeps √'s gradient finite
             sea = cos < -sh
             q_ = torch.addcmul(-(c1 * sh) ** 2, cos, cos * (c1 * c1)).clamp_min(1e-30)
             zeta = torch.log(torch.sqrt(q_) + torch.sqrt(q_ + 1.0))
-        gy = torch.addcmul(b_sea[sl, None, None], zeta, k_sea[sl, None, None])
+        gy = torch.addcmul(b_sea, zeta, k_sea)
         if has_sky:  # cos: the sky pixels' cos of the ray's zenith (dz)
-            gy = torch.where(sea, gy, torch.addcmul(b_sky[sl, None, None], cos, k_sky[sl, None, None]))
+            gy = torch.where(sea, gy, torch.addcmul(b_sky, cos, k_sky))
         if iso:
             gx = torch.zeros_like(gy)
         else:
-            o = _azimuth_coordinate(dx, dy, az_offset[sl], fold)
-            gx = torch.addcmul(b_az[sl, None, None], o, k_az[sl, None, None])
+            k_az = (2.0 / ((b - a) * (1.0 + ep))).to(dtype)[:, None, None]
+            b_az = ((-2.0 * a / (b - a) - 1.0) / (1.0 + ep)).to(dtype)[:, None, None]
+            offset = (math.pi / 2 - wd).to(dtype) if fold else (math.pi / 2 - rg.centre - wd.double()).to(dtype)
+            gx = torch.addcmul(b_az, _azimuth_coordinate(dx, dy, offset, fold), k_az)
         # bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges
         # only to first order; bilinear on the fine table is second order (~1e-7 at 4096 rows).
         vals = F.grid_sample(fine[:, None], torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border",

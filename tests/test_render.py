@@ -366,3 +366,30 @@ def test_camera_outside_the_path_tables_is_an_error():
                 rs.render(cams, scene, method=method)
         img = rs.render(cams, rs.SeaScene(wind_speed=5.0, sea_temperature=290.0, path=False))
         assert torch.isfinite(img).all()
+
+
+@pytest.mark.parametrize("altitude", [20.0, 100.0])
+def test_no_warm_line_at_the_horizon(altitude):
+    """The report: from a 20 m mast a one-pixel line at the horizon was 0.6–1.2 K warmer than the
+    sky just above it, because sky pixels saw the sea-level sky while the sea's horizon row sees
+    ~16 km of warm surface air. A ray just above the depressed horizon crosses that same air: its
+    radiance is L_path(h, r_hor) + τ(h, r_hor) · sky₀(90°) (midlatitude summer LWIR from 20 m:
+    ≈ 294.1 K). The sky pixels next to the horizon must show it, and the sea's first row must not
+    be warmer than them."""
+    h = altitude
+    dip = math.degrees(math.asin(math.sqrt(h * (2 * rs.EARTH_RADIUS_M + h)) / (rs.EARTH_RADIUS_M + h)))
+    H, W, vfov = 400, 4, 1.0  # 0.0025° a row
+    hfov = 2 * math.degrees(math.atan(math.tan(math.radians(vfov / 2)) * W / H))
+    cams = rs.make_camera(H, W, hfov_deg=hfov, altitude_m=h, pitch_deg=-dip + 0.0011, dtype=torch.float64)
+    geom = rs.view_geometry(cams)
+    bt = rs.render(cams, rs.SeaScene(wind_speed=6.0, sea_temperature=290.0), geometry=geom,
+                   output="brightness_temperature")[0, 0, :, W // 2]
+    k = int(geom.is_sea[0, :, W // 2].nonzero()[0])  # first sea row
+    path = rs.atmosphere.load_path("midlatitude_summer", dtype=torch.float64)
+    sky0 = rs.atmosphere.load_sky("midlatitude_summer", dtype=torch.float64)
+    r_hor = rs.atmosphere.horizon_range(torch.tensor(h, dtype=torch.float64))
+    tau, lp = path(torch.tensor(h, dtype=torch.float64), r_hor)
+    dip_bt = float(rs.brightness_temperature(lp + tau * sky0(torch.tensor(0.0, dtype=torch.float64))))
+    assert abs(float(bt[k - 1]) - dip_bt) < 0.02  # the sky row just above the horizon
+    assert float(bt[k]) < float(bt[k - 1]) + 0.05  # no warm line below it
+    assert float(bt[:k].max()) < dip_bt + 0.05  # nor anywhere in the sky near the horizon
