@@ -1,9 +1,14 @@
-"""On-the-fly sea backgrounds: throughput of RandomSeaBackground with the sensor model, its share of
-a training step, and the dataset generator's scaling with DataLoader workers.
+"""On-the-fly sea backgrounds: cost of the sensor model and of RandomSeaBackground against the
+renderer, at 1 and 2 threads, on an idle machine and beside a competing process; share of a
+training step; the dataset generator's scaling with DataLoader workers.
 
-1. 512×640 float32 batches: images/s of the renderer alone (radiance), of the sensor model alone,
-   and of ``RandomSeaBackground`` with ``SensorModel.typical_lwir()`` in replace and composite
-   mode (median of ``--repeats`` runs, each timed in this process; ratios against the renderer).
+1. 8×512×640 float32 batches, timed in one run, for 1 and 2 torch threads, each without and with a
+   competing busy-loop process (``python -c "while True: pass"``, started here and stopped at the
+   end of its block): the renderer alone (radiance), ``SensorModel.typical_lwir()`` alone (one
+   batched call, each image's noise from its own seed, as ``RandomSeaBackground`` runs it), the
+   same sensor image by image (how it ran before), and ``RandomSeaBackground`` with the sensor in
+   replace and composite mode. Variants are timed in turn within each repeat (so that a change of
+   load hits them alike); medians of ``--repeats``; ratios against the renderer of the same block.
 2. The example training loop (``examples/train_segmentation.py``): median augmentation time and
    net step time per step, and the share of a step that sea generation costs, at the example's
    size (128×160) and at 512×640.
@@ -22,6 +27,7 @@ import datetime as dt
 import os
 import platform
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -38,16 +44,25 @@ from roughsea_torch.sensor import SensorModel  # noqa: E402
 from train_segmentation import make_augmentation, ship_chips, train  # noqa: E402
 
 
-def median_time(fn, repeats: int, sync=lambda: None) -> float:
-    fn()
-    sync()
-    ts = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
+def median_times(fns: dict, repeats: int, sync=lambda: None) -> dict:
+    """Median time [s] of each callable, timed in turn within each repeat (after one warm-up
+    call each), so that a change of machine load hits every variant alike."""
+    ts = {name: [] for name in fns}
+    for fn in fns.values():
         fn()
         sync()
-        ts.append(time.perf_counter() - t0)
-    return statistics.median(ts)
+    for _ in range(repeats):
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            fn()
+            sync()
+            ts[name].append(time.perf_counter() - t0)
+    return {name: statistics.median(v) for name, v in ts.items()}
+
+
+def busy_process() -> subprocess.Popen:
+    """A competing process: one pure-Python busy loop (one core's worth of load), not pinned."""
+    return subprocess.Popen([sys.executable, "-c", "while True: pass"])
 
 
 def cpu_name() -> str:
@@ -64,6 +79,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--batch", type=int, default=8)
+    ap.add_argument("--height", type=int, default=512)
+    ap.add_argument("--width", type=int, default=640)
     ap.add_argument("--device", default="cpu")
     ap.add_argument("--gen-images", type=int, default=24, help="images per generator run")
     ap.add_argument("--train-steps", type=int, default=12)
@@ -71,13 +88,14 @@ def main() -> None:
     a = ap.parse_args()
     dev = torch.device(a.device)
     sync = (lambda: torch.cuda.synchronize()) if dev.type == "cuda" else (lambda: None)
-    B, H, W = a.batch, 512, 640
+    B, H, W = a.batch, a.height, a.width
     machine = (f"{cpu_name()}, {os.cpu_count()} cores, torch {torch.__version__} with {torch.get_num_threads()} threads"
                + (f", GPU {torch.cuda.get_device_name(dev)}" if dev.type == "cuda" else ""))
     lines = [f"# On-the-fly sea backgrounds ({dt.date.today().isoformat()})", "",
-             f"Machine: {machine}. Command: `python pipelines/bench_augmentation.py --repeats {a.repeats} --device {a.device}`.", ""]
+             f"Machine: {machine}. Command: `python pipelines/bench_augmentation.py --repeats {a.repeats} --batch {B} --height {H} --width {W} --device {a.device}`.", ""]
 
-    # 1. throughput at 512x640
+    # 1. sensor and augmentation against the renderer, 1 and 2 threads, without and with load
+    threads0 = torch.get_num_threads()
     g = torch.Generator().manual_seed(0)
     aug = RandomSeaBackground(sensor=SensorModel.typical_lwir()).to(dev)
     comp = make_augmentation().to(dev)
@@ -87,36 +105,70 @@ def main() -> None:
     params = sampler.sample(B, torch.Generator().manual_seed(2))
     L = render_parameters(params, H, W, sampler.atmospheres, device=dev)
     sensor = SensorModel.typical_lwir().to(dev)
+    seeds = params["noise_seed"].tolist()
 
-    def sensor_only():
-        for i in range(B):
-            sensor(L[i : i + 1], generator=torch.Generator().manual_seed(i))
+    def sensor_batched():
+        sensor(L, generator=[torch.Generator().manual_seed(int(s)) for s in seeds])
 
-    rows = [
-        ("renderer only (radiance)", lambda: render_parameters(params, H, W, sampler.atmospheres, device=dev)),
-        ("sensor model only", sensor_only),
-        ("RandomSeaBackground + sensor, replace", lambda: aug(x, generator=g)),
-        ("RandomSeaBackground + sensor, composite targets", lambda: comp(chips, generator=g)),
-    ]
-    times = {}
+    def sensor_looped():
+        for i, s in enumerate(seeds):
+            sensor(L[i : i + 1], generator=torch.Generator().manual_seed(int(s)))
+
+    stages = {
+        "renderer only (radiance)": lambda: render_parameters(params, H, W, sampler.atmospheres, device=dev),
+        "sensor model only (batched)": sensor_batched,
+        "sensor model only, image by image (as before)": sensor_looped,
+        "RandomSeaBackground + sensor, replace": lambda: aug(x, generator=g),
+        "RandomSeaBackground + sensor, composite targets": lambda: comp(chips, generator=g),
+    }
+    blocks = []  # (threads, loaded, {stage: seconds})
+    loads = []  # the machine's 1-minute load average before and after each block (other users' jobs count)
     with torch.no_grad():
-        for name, fn in rows:
-            times[name] = median_time(fn, a.repeats, sync)
-    base = times[rows[0][0]]
-    lines += [f"## 1. Throughput, {B}×{H}×{W} float32 batches on {a.device}", "",
-              "| stage | ms per batch | images/s | × renderer |", "|---|---:|---:|---:|"]
-    for name, t in times.items():
-        lines.append(f"| {name} | {1e3 * t:.0f} | {B / t:.1f} | {t / base:.2f} |")
+        for loaded in (False, True):
+            busy = busy_process() if loaded else None
+            try:
+                for threads in (1, 2):
+                    torch.set_num_threads(threads)
+                    load0 = os.getloadavg()[0]
+                    blocks.append((threads, loaded, median_times(stages, a.repeats, sync)))
+                    loads.append((load0, os.getloadavg()[0]))
+                    print(blocks[-1], flush=True)
+            finally:
+                if busy is not None:
+                    busy.kill()
+                    busy.wait()
+    torch.set_num_threads(threads0)
+    lines += [f"## 1. Sensor and augmentation against the renderer, {B}×{H}×{W} float32 batches on {a.device}", "",
+              "Each block is timed in one run: its stages in turn within each repeat, medians of "
+              f"{a.repeats}. *Competing process*: a busy loop (`python -c \"while True: pass\"`) running beside "
+              "the benchmark.", "",
+              f"The load average column is the machine's 1-minute load before → after the block ({os.cpu_count()} cores; "
+              "other users' jobs count): far above 1 per core, absolute times are inflated and only the ratios "
+              "within a block compare.", "",
+              "| threads | competing process | load average | stage | ms per batch | images/s | × renderer |",
+              "|---:|---|---|---|---:|---:|---:|"]
+    for (threads, loaded, times), (l0, l1) in zip(blocks, loads):
+        base = times["renderer only (radiance)"]
+        for name, t in times.items():
+            lines.append(f"| {threads} | {'yes' if loaded else 'no'} | {l0:.1f} → {l1:.1f} | {name} | {1e3 * t:.0f} | "
+                         f"{B / t:.1f} | {t / base:.2f} |")
+    lines += ["", "2 threads against 1 thread (time at 1 thread / time at 2 threads; above 1: 2 threads faster):", "",
+              "| competing process | stage | × speed-up |", "|---|---|---:|"]
+    by = {(th, ld): t for th, ld, t in blocks}
+    for loaded in (False, True):
+        for name in stages:
+            lines.append(f"| {'yes' if loaded else 'no'} | {name} | {by[(1, loaded)][name] / by[(2, loaded)][name]:.2f} |")
 
     # 2. share of a training step
     lines += ["", "## 2. Share of a training step (examples/train_segmentation.py)", "",
-              "| image size | batch | augmentation ms/step | net fwd+bwd ms/step | sea generation share |", "|---|---:|---:|---:|---:|"]
+              "| threads | image size | batch | augmentation ms/step | net fwd+bwd ms/step | sea generation share |",
+              "|---:|---|---:|---:|---:|---:|"]
     shares = []
     for (h, w) in ((128, 160), (H, W)):
         r = train(a.train_steps, B, h, w, seed=0, log=lambda *_: None)
         ta, tn = statistics.median(r["t_aug"][1:]), statistics.median(r["t_net"][1:])
         shares.append(((h, w), ta, tn))
-        lines.append(f"| {h}×{w} | {B} | {1e3 * ta:.0f} | {1e3 * tn:.0f} | {100 * ta / (ta + tn):.0f} % |")
+        lines.append(f"| {torch.get_num_threads()} | {h}×{w} | {B} | {1e3 * ta:.0f} | {1e3 * tn:.0f} | {100 * ta / (ta + tn):.0f} % |")
 
     # 3. generator scaling with DataLoader workers
     cfg = {"seed": 0, "num_images": a.gen_images, "shard_size": 4, "batch_size": 4, "camera": {"height": H, "width": W},
@@ -142,11 +194,18 @@ def main() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
-    names = list(times)
-    axes[0].barh(range(len(names)), [B / times[n] for n in names], color="tab:blue")
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2), gridspec_kw={"width_ratios": [2.2, 1, 1]})
+    names = list(stages)
+    width = 0.8 / len(blocks)
+    for k, (threads, loaded, times) in enumerate(blocks):
+        axes[0].barh([i + (k - (len(blocks) - 1) / 2) * width for i in range(len(names))],
+                     [1e3 * times[n] for n in names], height=width,
+                     label=f"{threads} thread{'s' if threads > 1 else ''}, {'busy loop beside' if loaded else 'no busy loop'}")
     axes[0].set_yticks(range(len(names)), [n.replace("RandomSeaBackground", "RSB") for n in names], fontsize=7)
-    axes[0].set_xlabel(f"images/s ({H}×{W}, batch {B})")
+    axes[0].invert_yaxis()
+    axes[0].set_xscale("log")
+    axes[0].set_xlabel(f"ms per batch of {B}×{H}×{W} (log scale)")
+    axes[0].legend(fontsize=7)
     labels = [f"{h}×{w}" for (h, w), _, _ in shares]
     axes[1].bar(labels, [1e3 * ta for _, ta, _ in shares], label="sea generation")
     axes[1].bar(labels, [1e3 * tn for _, _, tn in shares], bottom=[1e3 * ta for _, ta, _ in shares], label="net fwd+bwd")

@@ -23,6 +23,7 @@ from +x towards +y; the camera's yaw in the same frame), altitude in m, wind spe
 from __future__ import annotations
 
 import math
+import os
 from typing import Any, Sequence
 
 import torch
@@ -33,6 +34,7 @@ from .expectation import Quadrature
 from .geometry import EARTH_RADIUS_M, make_camera
 from .radiometry import LWIR, as_band, band_radiance, brightness_temperature
 from .render import SeaScene, TableSize, render
+from .sensor import SensorModel
 
 __all__ = ["SceneSampler", "RandomSeaBackground", "render_parameters", "SCENE_FIELDS"]
 
@@ -94,14 +96,18 @@ class SceneSampler:
         sea_temperature: T_sea [K], in [260, 320].
         air_temperature: T_air [K] of the surface air, in [230, 330]; ``None`` (default): each
             atmosphere's own surface air temperature (see ``SeaScene``).
-        altitude_m: sensor height above the sea [m], in [0.5, 20000] (a camera below the sea is
-            refused here, before any work).
+        altitude_m: sensor height above the sea [m], in [2, 5000] with the atmospheric path on (the
+            altitudes its tables cover), in [0.5, 20000] with ``path=False`` (a camera below the
+            sea, or outside the path tables, is refused here, before any work).
         pitch_deg: elevation of the optical axis [deg], in [−90, 90]; negative looks down.
         roll_deg: [deg], in [−180, 180].
         yaw_deg: azimuth of the optical axis [deg] (with a random wind direction a fixed yaw
             loses nothing).
         hfov_deg: horizontal field of view [deg], in [0.5, 179].
         atmospheres: names of shipped LOWTRAN7 atmospheres, drawn with equal probability.
+        path: whether the images will be rendered with the atmospheric path between sea and sensor
+            (the renderer's default); it only sets the allowed ``altitude_m``.
+        band: the sensor band of the path tables (``LWIR`` default, ``MWIR`` or (λ_lo, λ_hi) [m]).
 
     ``sample(B, generator)`` returns a dict of CPU float64 tensors (B,) under these names plus
     ``"atmosphere"`` (int64 index into ``atmospheres``) and ``"noise_seed"`` (int64, for the sensor
@@ -115,11 +121,14 @@ class SceneSampler:
         (True, [-3.0, -3.0, -3.0])
     """
 
-    def __init__(self, *, atmospheres: Sequence[str] | str = ("midlatitude_summer",), **ranges: Any):
+    def __init__(self, *, atmospheres: Sequence[str] | str = ("midlatitude_summer",), path: bool = True,
+                 band: Any = LWIR, **ranges: Any):
         unknown = set(ranges) - set(_FIELD_NAMES)
         if unknown:
             raise ValueError(f"unknown scene parameter(s) {sorted(unknown)}; known: {list(_FIELD_NAMES) + ['atmospheres']}")
-        from .atmosphere import available_atmospheres, surface_air_temperature
+        if not isinstance(path, bool):
+            raise ValueError(f"path must be True or False; got {path!r}")
+        from .atmosphere import available_atmospheres, load_path, surface_air_temperature
 
         names = [atmospheres] if isinstance(atmospheres, str) else list(atmospheres)
         if not names:
@@ -134,6 +143,18 @@ class SceneSampler:
         for name, allowed, unit, default in SCENE_FIELDS:
             value = ranges.get(name, default)
             self.ranges[name] = None if value is None else _range(name, value, allowed, unit)
+        self.path = path
+        if path:  # the atmospheric path between sea and sensor is tabulated over a band of altitudes
+            band = as_band(band)
+            tables = [load_path(n, (band.lo, band.hi), band.response).altitude_range_m for n in names]
+            lo, hi = max(t[0] for t in tables), min(t[1] for t in tables)
+            a, b = self.ranges["altitude_m"]
+            if a < lo or b > hi:
+                raise ValueError(
+                    f"altitude_m: the range ({a:g}, {b:g}) m leaves [{lo:g}, {hi:g}] m, the camera altitudes of "
+                    f"the atmospheric path tables (path on); keep altitude_m within [{lo:g}, {hi:g}] m, or turn "
+                    f"the path off (path=False) for the full [{SCENE_FIELDS[4][1][0]:g}, {SCENE_FIELDS[4][1][1]:g}] m"
+                )
 
     def config(self) -> dict[str, Any]:
         """The ranges as plain Python values (for metadata and configs)."""
@@ -217,6 +238,36 @@ def render_parameters(
     return out
 
 
+def _worker_stream(generator: torch.Generator, worker_id: int) -> torch.Generator:
+    """A DataLoader worker's own generator: seeded by :func:`image_seed` of a number drawn from
+    a copy of ``generator`` (its state as the worker received it; the original is not advanced)
+    and the worker's id. Each worker gets a different stream, and the same one on every run that
+    seeds ``generator`` the same way."""
+    copy = torch.Generator().set_state(generator.get_state())
+    base = int(torch.randint(0, 2**62, (1,), generator=copy))
+    return torch.Generator().manual_seed(image_seed(base, worker_id))
+
+
+def _check_input(input: Any, mode: str) -> None:
+    """``ValueError`` for an input dtype that cannot carry the result, or (composite mode) an
+    opacity outside [0, 1]."""
+    if not isinstance(input, torch.Tensor):
+        raise ValueError(f"input must be a torch.Tensor; got {type(input).__name__}")
+    if input.dtype not in (torch.float32, torch.float64):
+        raise ValueError(
+            f"input: dtype must be torch.float32 or torch.float64; got {input.dtype}. The output has the "
+            "input's dtype, and half precision cannot hold it to the sensor's resolution (float16 steps are "
+            "0.25 K near 290 K, rounding by up to 0.125 K against a 0.05 K NETD, and integers above 2048, "
+            "as 14-bit counts, are not exact): pass float32 and cast the output if you need it smaller"
+        )
+    if mode == "composite" and input.shape[-3] == 2 and input.numel():
+        alpha = input.detach()[..., 1, :, :]
+        lo, hi = (float(v) for v in torch.aminmax(alpha))
+        if not (0.0 <= lo and hi <= 1.0):  # NaN fails too
+            raise ValueError(f"alpha (input channel 1, the target's opacity) must lie in [0, 1]; got values in "
+                             f"[{lo:g}, {hi:g}]")
+
+
 class RandomSeaBackground(IntensityAugmentationBase2D):
     """Replace images with random, physically rendered infrared sea backgrounds, or composite
     targets onto them.
@@ -229,22 +280,34 @@ class RandomSeaBackground(IntensityAugmentationBase2D):
         mode: ``"replace"``: the output is the rendered sea, repeated over the input's channels
             (the input's values are not used, only its shape, dtype and device); ``"composite"``:
             the input has two channels, a target's value (channel 0, in ``target_unit``) and its
-            opacity α ∈ [0, 1] (channel 1); channel 0 of the output is α L_target + (1 − α) L_sea
-            in radiance (then the sensor model), channel 1 is α unchanged.
+            opacity α ∈ [0, 1] (channel 1; a value outside [0, 1] is a ``ValueError``, not clamped);
+            channel 0 of the output is α L_target + (1 − α) L_sea in radiance (then the sensor
+            model), channel 1 is α unchanged.
         target_unit: ``"temperature"`` (blackbody temperature [K] of the target as seen at the
             sensor) or ``"radiance"`` [W m⁻² sr⁻¹].
         sensor: a sensor model (``roughsea_torch.sensor.SensorModel`` or any module
             ``sensor(radiance, generator=g)``) applied after compositing; its random stages draw
-            from a generator seeded by each image's ``noise_seed``, so replays repeat the noise.
+            from a generator seeded by each image's ``noise_seed``, so replays repeat the noise. A
+            :class:`~roughsea_torch.sensor.SensorModel` runs once on the batch (its noise drawn
+            per image from those generators); another module is called image by image.
         output: ``"radiance"``, ``"brightness_temperature"`` [K], or ``"sensor"`` (the sensor
             model's output, e.g. counts; the default when a sensor is given).
         table, quadrature, path: renderer settings (see :func:`~roughsea_torch.render.render`).
         generator: a CPU ``torch.Generator`` used for every draw of this instance when ``forward``
-            gets none; ``forward(x, generator=g)`` seeds one call.
+            gets none; ``forward(x, generator=g)`` seeds one call. Inside a
+            ``torch.utils.data.DataLoader`` worker, each worker replaces it on first use by its own
+            stream, seeded from the generator's state as the worker received it and the worker's
+            id: workers draw different scenes, and the same ones on every run seeded the same way.
+            Workers that are not persistent restart from that state every epoch (and so repeat
+            their scenes); use ``persistent_workers=True`` for new scenes each epoch.
         p, same_on_batch, keepdim: kornia's (images not selected by ``p`` come back unchanged and
             are not rendered).
 
-    Shapes: input (B, C, H, W) or (C, H, W) float; output the same shape and dtype.
+    Shapes: input (B, C, H, W) or (C, H, W), float32 or float64; output the same shape and dtype.
+    Other dtypes are a ``ValueError`` naming ``input``: the output has the input's dtype, and
+    float16 (0.25 K steps near 290 K, so rounding errors up to 0.125 K against a 0.05 K NETD;
+    integers exact only up to 2048, below 14-bit counts) or bfloat16 cannot hold it to the sensor's
+    resolution. Cast to float32, and the output back if needed.
 
     Example:
         >>> aug = RandomSeaBackground(wind_speed=(2.0, 12.0), output="brightness_temperature")
@@ -285,7 +348,7 @@ class RandomSeaBackground(IntensityAugmentationBase2D):
         self.sampler = SceneSampler(
             atmospheres=atmospheres, wind_speed=wind_speed, wind_direction_deg=wind_direction_deg,
             sea_temperature=sea_temperature, air_temperature=air_temperature, altitude_m=altitude_m,
-            pitch_deg=pitch_deg, roll_deg=roll_deg, yaw_deg=yaw_deg, hfov_deg=hfov_deg,
+            pitch_deg=pitch_deg, roll_deg=roll_deg, yaw_deg=yaw_deg, hfov_deg=hfov_deg, path=path, band=band,
         )
         if mode not in ("replace", "composite"):
             raise ValueError(f"mode must be 'replace' or 'composite'; got {mode!r}")
@@ -310,11 +373,13 @@ class RandomSeaBackground(IntensityAugmentationBase2D):
         self.path = path
         self.generator = generator
         self._call_generator: torch.Generator | None = None
+        self._worker: tuple[tuple[int, int], torch.Generator] | None = None
 
     def forward(self, input: torch.Tensor, params: dict[str, torch.Tensor] | None = None,
                 generator: torch.Generator | None = None, **kwargs: Any) -> torch.Tensor:
         if generator is not None and generator.device.type != "cpu":
             raise ValueError("generator must be a CPU torch.Generator")
+        _check_input(input, self.mode)
         self._call_generator = generator
         try:
             return super().forward(input, params=params, **kwargs)
@@ -322,7 +387,20 @@ class RandomSeaBackground(IntensityAugmentationBase2D):
             self._call_generator = None
 
     def _generator(self) -> torch.Generator | None:
-        return self._call_generator if self._call_generator is not None else self.generator
+        """The generator of this draw: the one given to ``forward``, else the instance's; inside a
+        DataLoader worker the instance's is replaced, on first use, by the worker's own stream
+        (see :func:`_worker_stream`)."""
+        if self._call_generator is not None:
+            return self._call_generator
+        if self.generator is None:
+            return None
+        info = torch.utils.data.get_worker_info()
+        if info is None:
+            return self.generator
+        key = (os.getpid(), int(info.id))
+        if self._worker is None or self._worker[0] != key:
+            self._worker = (key, _worker_stream(self.generator, int(info.id)))
+        return self._worker[1]
 
     def __batch_prob_generator__(self, batch_shape: tuple[int, ...], p: float, p_batch: float, same_on_batch: bool) -> torch.Tensor:
         g = self._generator()
@@ -342,7 +420,7 @@ class RandomSeaBackground(IntensityAugmentationBase2D):
         B, C, H, W = input.shape
         if self.mode == "composite" and C != 2:
             raise ValueError(f"input: mode='composite' needs 2 channels (target value, alpha); got {C}")
-        dtype = input.dtype if input.dtype in (torch.float32, torch.float64) else torch.float32
+        dtype = input.dtype  # float32 or float64 (forward refuses others)
         gate = params["batch_prob"].reshape(-1).cpu() > 0.5 if "batch_prob" in params else torch.ones(B, dtype=torch.bool)
         if gate.numel() == 1:
             gate = gate.expand(B)
@@ -357,17 +435,17 @@ class RandomSeaBackground(IntensityAugmentationBase2D):
         )
         if self.mode == "composite":
             target = input[idx, :1].to(dtype)
-            alpha = input[idx, 1:2].to(dtype).clamp(0.0, 1.0)
+            alpha = input[idx, 1:2].to(dtype)  # in [0, 1]: forward checked it
             covered = alpha > 0
             if self.target_unit == "temperature":  # Planck only where a target shows (a band sum per pixel)
                 target = torch.zeros_like(L).index_put((covered,), band_radiance(target[covered], self.band))
             L = torch.where(covered, torch.lerp(L, target, alpha), L)
         if self.output == "sensor":
-            seeds = sub["noise_seed"].tolist()
-            L = torch.cat([
-                self.sensor(L[i : i + 1], generator=torch.Generator().manual_seed(int(s)))
-                for i, s in enumerate(seeds)
-            ])
+            gens = [torch.Generator().manual_seed(int(s)) for s in sub["noise_seed"].tolist()]
+            if isinstance(self.sensor, SensorModel):  # one batched call, each image's noise from its own seed
+                L = self.sensor(L, generator=gens)
+            else:  # any module sensor(radiance, generator=g): image by image
+                L = torch.cat([self.sensor(L[i : i + 1], generator=g) for i, g in enumerate(gens)])
         elif self.output == "brightness_temperature":
             L = brightness_temperature(L.clamp_min(torch.finfo(dtype).tiny), self.band)
         L = L.to(input.dtype)

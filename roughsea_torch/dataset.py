@@ -70,9 +70,10 @@ def _band(name: Any) -> SpectralBand:
 
 
 def _sampler(scene: dict[str, Any]) -> SceneSampler:
-    """The SceneSampler of a config's ``scene`` table (its ranges; band and renderer switches aside)."""
-    return SceneSampler(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in scene.items()
-                           if k not in ("band", "anisotropic", "path")})
+    """The SceneSampler of a config's ``scene`` table (its ranges, checked against the path tables
+    when ``path`` is on; ``anisotropic`` aside)."""
+    return SceneSampler(band=_band(scene["band"]), **{k: (tuple(v) if isinstance(v, list) else v)
+                                                       for k, v in scene.items() if k not in ("band", "anisotropic")})
 
 
 def _stage_classes() -> dict[str, type]:
@@ -213,6 +214,8 @@ def render_shard(cfg: dict[str, Any], k: int, sensor: torch.nn.Module | None = N
             sub = {n: v[i : i + bs] for n, v in params.items()}
             L = render_parameters(sub, H, W, sampler.atmospheres, band=_band(sc["band"]), anisotropic=sc["anisotropic"],
                                   dtype=dtype, device=device, path=sc["path"])
+            # image by image: a shard's image is then exactly what re-rendering it alone from its metadata
+            # gives (the blur's convolution may differ in the last bit between batch sizes)
             for j in range(L.shape[0]):
                 g = torch.Generator().manual_seed(int(sub["noise_seed"][j]))  # CPU draws: the same noise on any device
                 c = sensor(L[j : j + 1], generator=g)

@@ -17,7 +17,8 @@ Conventions:
       into radiance with the band's dL/dT); radiance in W m⁻² sr⁻¹ in the sensor band; blur widths
       in pixels; counts are integers held in a float tensor.
     - Randomness: the temporal noise draws from the ``generator`` passed to ``forward`` (the global
-      RNG when None); the fixed pattern comes from the stage's own ``seed`` and is the same on every
+      RNG when None; a sequence of B generators gives each image its own stream in one batched
+      call); the fixed pattern comes from the stage's own ``seed`` and is the same on every
       call. A generator on another device than the image is fine: the draw is made on the
       generator's device and moved, so one seed gives the same noise on CPU and CUDA.
     - Gradients flow through every stage (the rounding in :class:`ToCounts` and :class:`ToDisplay`
@@ -57,6 +58,7 @@ __all__ = [
 # radiance): the bottom of radiometry's tabulated inverse, far below any sea or sky scene.
 _T_FLOOR = 100.0
 _TRUNCATE = 4.0  # Gaussian kernel half-width in σ, as scipy.ndimage.gaussian_filter's default
+_SEPARABLE_ABOVE = 15  # kernels wider than this [px] are applied as two 1-D passes
 
 
 # --------------------------------------------------------------------------------------------------
@@ -99,13 +101,29 @@ def _check_pair(name: str, x: Any, lo: float, unit: str, lo_open: bool = False) 
     return a, b
 
 
-def _randn(shape: Sequence[int], generator: torch.Generator | None, dtype: torch.dtype,
-           device: torch.device) -> torch.Tensor:
-    """Standard normal draws from ``generator`` (global RNG when None), made on the generator's
-    device and moved to ``device``."""
+def _randn(shape: Sequence[int], generator: Any, dtype: torch.dtype, device: torch.device) -> torch.Tensor:
+    """Standard normal draws of ``shape`` (B, ...), made on the generator's device and moved to
+    ``device``.
+
+    ``generator``: None (the global RNG), a ``torch.Generator``, or a sequence of B generators,
+    one per image: image i's draws then come from ``generator[i]`` alone, exactly the values
+    ``torch.randn((1, *shape[1:]), generator=generator[i])`` gives (each is drawn straight into
+    its slice of one preallocated tensor), so an image's noise does not depend on its batch.
+    """
+    shape = tuple(shape)
     if generator is None:
-        return torch.randn(tuple(shape), dtype=dtype, device=device)
-    z = torch.randn(tuple(shape), generator=generator, dtype=dtype, device=generator.device)
+        return torch.randn(shape, dtype=dtype, device=device)
+    if isinstance(generator, torch.Generator):
+        return torch.randn(shape, generator=generator, dtype=dtype, device=generator.device).to(device)
+    gens = list(generator)
+    if len(gens) != shape[0] or not all(isinstance(g, torch.Generator) for g in gens):
+        raise ValueError(f"generator: give None, a torch.Generator, or a sequence of {shape[0]} torch.Generators "
+                         f"(one per image); got {len(gens)} items")
+    if len({g.device for g in gens}) > 1:
+        raise ValueError(f"generator: the per-image generators must share one device; got {sorted({str(g.device) for g in gens})}")
+    z = torch.empty(shape, dtype=dtype, device=gens[0].device if gens else device)
+    for i, g in enumerate(gens):
+        torch.randn(shape[1:], generator=g, dtype=dtype, device=g.device, out=z[i])
     return z.to(device)
 
 
@@ -208,7 +226,10 @@ def optics_blur(image: torch.Tensor, sigma_px: Any, kernel_size: int | None = No
         ks = (kernel_size, kernel_size)
     # kornia needs σ > 0; a σ of 1e-6 px gives exactly the unit impulse (exp(−5e11) = 0).
     s = sigma.clamp_min(1e-6)
-    return kornia.filters.gaussian_blur2d(image, ks, torch.stack([s, s], dim=-1), border_type="reflect")
+    # up to 15 px wide, one 2-D convolution (one pass over the batch) is faster than kornia's separable
+    # form, which makes two shifted multiply-adds per kernel row and column (2k passes)
+    return kornia.filters.gaussian_blur2d(image, ks, torch.stack([s, s], dim=-1), border_type="reflect",
+                                          separable=max(ks) > _SEPARABLE_ABOVE)
 
 
 class OpticsBlur(nn.Module):
@@ -271,16 +292,70 @@ def noise_equivalent_radiance(netd_k: Any, temperature: Any, band: Any = LWIR) -
     return netd * _band_radiance_dT(t, band)
 
 
+_SLOPE_T_MAX = 499.0  # top of the dL/dT grid [K], inside radiometry's 100–500 K table; brighter pixels: per-pixel lookup
+_SLOPE_NODES = 16384  # nodes of the dL/dT grid, uniform in log L over [L(_T_FLOOR), L(_SLOPE_T_MAX)]
+_slope_tables: dict[tuple, tuple[float, float, float, torch.Tensor, torch.Tensor]] = {}
+
+
+def _slope_table(band: Any, dtype: torch.dtype, device: torch.device) -> tuple[float, float, float, torch.Tensor, torch.Tensor]:
+    """(log L₀, 1/Δ(log L), L_max, f, Δf): dL/dT from :func:`band_radiance_slope` at radiances
+    uniform in log L between the band radiances of ``_T_FLOOR`` and ``_SLOPE_T_MAX`` (made once
+    per band in float64, then cast and cached per dtype and device)."""
+    band = as_band(band)
+    key = (band.lo, band.hi, id(band.response), band.nodes_per_panel)
+    hit = _slope_tables.get(key + (dtype, str(device)))
+    if hit is None:
+        base = _slope_tables.get(key + (torch.float64, "cpu"))
+        if base is None:
+            ends = band_radiance(torch.tensor([_T_FLOOR, _SLOPE_T_MAX], dtype=torch.float64), band)
+            y0, y1 = (float(v) for v in torch.log(ends))
+            step = (y1 - y0) / (_SLOPE_NODES - 1)
+            # clamped to the ends: exp(log L) may round just outside radiometry's table (a slow path)
+            nodes = torch.exp(y0 + step * torch.arange(_SLOPE_NODES, dtype=torch.float64)).clamp(ends[0], ends[1])
+            f = band_radiance_slope(nodes, band)
+            df = torch.cat([f[1:] - f[:-1], f.new_zeros(1)])  # the last node's cell is empty (u = n − 1 exactly)
+            base = (y0, 1.0 / step, float(ends[1]), f, df)
+        hit = base[:3] + tuple(t.to(dtype=dtype, device=device) for t in base[3:])
+        if band.response is None:  # a callable response is keyed by identity: not kept
+            _slope_tables[key + (torch.float64, "cpu")] = base
+            _slope_tables[key + (dtype, str(device))] = hit
+    return hit
+
+
+def _radiance_slope(radiance: torch.Tensor, band: Any, scale: float = 1.0) -> torch.Tensor:
+    """``scale`` × dL/dT [W m⁻² sr⁻¹ K⁻¹] at each pixel's brightness temperature, radiances below
+    that of ``_T_FLOOR`` (100 K) taken at 100 K: the noise's standard deviation per NETD.
+
+    :func:`~roughsea_torch.radiometry.band_radiance_slope` tabulated once at radiances uniform in
+    log L over 100–499 K, then read per pixel by linear interpolation in log L: the cell is an
+    index computed from log L (no search) and the read two gathers and one multiply-add, where
+    the per-pixel lookup costs more than the rest of the sensor model on large batches. dL/dT is
+    smooth in log L (≈ L · c₂/(λT²)), so the table is within 2e-6 (LWIR) and 2e-5 (MWIR) of the
+    exact band sum (``tests/test_sensor.py``). Pixels above 499 K take the per-pixel lookup.
+    The grid is fixed, so a pixel's value does not depend on the rest of its batch."""
+    y0, inv_step, l_max, f, df = _slope_table(band, radiance.dtype, radiance.device)
+    if scale != 1.0:
+        f, df = f * scale, df * scale
+    x = radiance.clamp(math.exp(y0), l_max)  # below L(100 K): taken at 100 K (documented floor)
+    affine = torch.tensor([-y0 * inv_step, inv_step], dtype=radiance.dtype).to(radiance.device)
+    u = torch.addcmul(affine[0], torch.log(x), affine[1])  # (log L − log L₀)/Δ ∈ [0, n − 1] up to rounding
+    i = u.detach().to(torch.int32).reshape(-1)
+    out = torch.addcmul(f.index_select(0, i).view(u.shape), torch.frac(u), df.index_select(0, i).view(u.shape))
+    if float(radiance.detach().max()) > l_max:
+        out = torch.where(radiance > l_max, scale * band_radiance_slope(radiance.clamp_min(l_max), band), out)
+    return out
+
+
 def _noise_std(radiance: torch.Tensor, netd: torch.Tensor, band: Any,
                reference_temperature: float | None) -> torch.Tensor:
     """Per-pixel (or per-image) noise standard deviation in radiance, broadcastable to the image."""
     B = radiance.shape[0]
-    netd = netd.view(B, 1, 1, 1)
     if reference_temperature is not None:
         t = torch.tensor(reference_temperature, dtype=radiance.dtype, device=radiance.device)
-        return netd * _band_radiance_dT(t, band)
-    floor = band_radiance(torch.tensor(_T_FLOOR, dtype=radiance.dtype, device=radiance.device), band)
-    return netd * band_radiance_slope(torch.maximum(radiance, floor), band)
+        return netd.view(B, 1, 1, 1) * _band_radiance_dT(t, band)
+    if not netd.requires_grad and B and bool((netd == netd[0]).all()):  # one NETD: folded into the table
+        return _radiance_slope(radiance, band, float(netd[0]))
+    return netd.view(B, 1, 1, 1) * _radiance_slope(radiance, band)
 
 
 def detector_noise(
@@ -288,7 +363,7 @@ def detector_noise(
     netd_k: Any = 0.05,
     band: Any = LWIR,
     reference_temperature: float | None = None,
-    generator: torch.Generator | None = None,
+    generator: torch.Generator | Sequence[torch.Generator] | None = None,
 ) -> torch.Tensor:
     """Add temporal white Gaussian noise of a given NETD.
 
@@ -300,7 +375,10 @@ def detector_noise(
             own brightness temperature (pixels below 100 K, or of non-positive radiance, use 100 K),
             so its standard deviation in kelvin is the NETD everywhere; a temperature [K]: one
             standard deviation NETD × dL/dT(T_ref) for all pixels (a constant-NEΔL detector).
-        generator: ``torch.Generator`` for the draws (any device); None: the global RNG.
+        generator: ``torch.Generator`` for the draws (any device); or a sequence of B generators,
+            one per image (image i's draws are those ``generator[i]`` gives for that image alone,
+            so a batch reproduces images noised one by one with their own seeds); None: the
+            global RNG.
 
     Returns:
         radiance + σ·z, z ~ N(0, 1) independent per pixel, (B, C, H, W), same dtype and device.
@@ -316,7 +394,7 @@ def detector_noise(
     z = _randn(radiance.shape, generator, radiance.dtype, radiance.device)
     if radiance.numel() == 0:
         return radiance.clone()
-    return radiance + _noise_std(radiance, netd, band, reference_temperature) * z
+    return torch.addcmul(radiance, _noise_std(radiance, netd, band, reference_temperature), z)
 
 
 class DetectorNoise(nn.Module):
@@ -328,7 +406,8 @@ class DetectorNoise(nn.Module):
         reference_temperature: None (σ at each pixel's brightness temperature) or a temperature [K]
             at which dL/dT is taken for all pixels.
 
-    ``forward(radiance, generator=None)``: (B, C, H, W) → (B, C, H, W).
+    ``forward(radiance, generator=None)``: (B, C, H, W) → (B, C, H, W); ``generator`` as in
+    :func:`detector_noise` (one generator, one per image, or None).
     """
 
     def __init__(self, netd_k: Any = 0.05, band: Any = LWIR, reference_temperature: float | None = None) -> None:
@@ -342,7 +421,7 @@ class DetectorNoise(nn.Module):
         self.band = as_band(band)
         self.reference_temperature = reference_temperature
 
-    def forward(self, radiance: torch.Tensor, generator: torch.Generator | None = None) -> torch.Tensor:
+    def forward(self, radiance: torch.Tensor, generator: torch.Generator | Sequence[torch.Generator] | None = None) -> torch.Tensor:
         return detector_noise(radiance, self.netd_k, self.band, self.reference_temperature, generator)
 
     def extra_repr(self) -> str:
@@ -401,11 +480,16 @@ class FixedPatternNoise(nn.Module):
         t_ref = torch.tensor(self.reference_temperature, dtype=torch.float64)
         self._l_ref = float(band_radiance(t_ref, self.band))
         self._dl_dt = float(_band_radiance_dT(t_ref, self.band))
-        self._patterns: dict[tuple, tuple[torch.Tensor, torch.Tensor]] = {}
+        self._patterns: dict[tuple, tuple[torch.Tensor, ...]] = {}
 
     def pattern(self, height: int, width: int, dtype: torch.dtype = torch.float64,
                 device: torch.device | str = "cpu") -> tuple[torch.Tensor, torch.Tensor]:
         """The pattern for an H × W image: gain 1 + δg (H, W) [1] and offset o (H, W) [W m⁻² sr⁻¹]."""
+        return self._pattern(height, width, dtype, device)[:2]
+
+    def _pattern(self, height: int, width: int, dtype: torch.dtype,
+                 device: torch.device | str) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """(gain, offset, bias) with bias = L_ref (1 − gain) + offset [W m⁻² sr⁻¹], cached."""
         height = _check_int("height", height, 1)
         width = _check_int("width", width, 1)
         device = torch.device(device)
@@ -418,15 +502,16 @@ class FixedPatternNoise(nn.Module):
             z_col = torch.randn(width, generator=g, dtype=torch.float64)
             gain = 1.0 + self.gain_std * z_gain
             offset = (self.offset_std_k * z_pix + self.column_std_k * z_col) * self._dl_dt
-            hit = (gain.to(dtype=dtype, device=device), offset.to(dtype=dtype, device=device))
+            bias = self._l_ref * (1.0 - gain) + offset  # L' = gain · L + bias: one fused op per call
+            hit = tuple(a.to(dtype=dtype, device=device) for a in (gain, offset, bias))
             self._patterns[key] = hit
         return hit
 
     def forward(self, radiance: torch.Tensor) -> torch.Tensor:
         radiance = _check_image("radiance", radiance)
         H, W = radiance.shape[-2:]
-        gain, offset = self.pattern(H, W, radiance.dtype, radiance.device)
-        return self._l_ref + gain * (radiance - self._l_ref) + offset
+        gain, _, bias = self._pattern(H, W, radiance.dtype, radiance.device)
+        return torch.addcmul(bias, gain, radiance)
 
     def extra_repr(self) -> str:
         return (f"gain_std={self.gain_std}, offset_std_k={self.offset_std_k}, column_std_k={self.column_std_k}, "
@@ -456,10 +541,11 @@ def radiance_to_counts(radiance: torch.Tensor, gain: float, offset: float, bits:
     check_finite_range("gain", gain, 0.0, math.inf, lo_open=True, hi_open=True, unit="counts per W m-2 sr-1")
     check_finite_range("offset", offset, -math.inf, math.inf, lo_open=True, hi_open=True, unit="counts")
     bits = _check_int("bits", bits, 1, 24)
-    c = radiance * float(gain) + float(offset)
+    scalars = torch.tensor([float(offset), float(gain)], dtype=radiance.dtype).to(radiance.device)
+    c = torch.addcmul(scalars[0], radiance, scalars[1])  # gain · L + offset in one pass
     if rounding:
-        c = _round_ste(c)
-    return c.clamp(0.0, float(2**bits - 1))
+        c = _round_ste(c) if c.requires_grad else c.round_()
+    return c.clamp_(0.0, float(2**bits - 1)) if not c.requires_grad else c.clamp(0.0, float(2**bits - 1))
 
 
 def counts_to_radiance(counts: torch.Tensor, gain: float, offset: float) -> torch.Tensor:
@@ -654,7 +740,10 @@ class SensorModel(nn.Module):
 
     ``forward(radiance, generator=None)``: ``generator`` (a ``torch.Generator`` on any device) is
     passed to every stage whose ``forward`` has a ``generator`` parameter, so a seeded generator
-    makes a run reproducible bit for bit; None uses the global RNG.
+    makes a run reproducible bit for bit; None uses the global RNG. A sequence of B generators
+    gives each image its own stream (image i's temporal noise is what ``generator[i]`` gives it
+    alone) while the batch runs as one: :class:`DetectorNoise` draws each image's noise into one
+    tensor; a custom stage that takes a generator is called image by image.
 
     Example:
         >>> sensor = SensorModel.typical_lwir()
@@ -704,11 +793,23 @@ class SensorModel(nn.Module):
             display=None,
         )
 
-    def forward(self, radiance: torch.Tensor, generator: torch.Generator | None = None) -> torch.Tensor:
+    def forward(self, radiance: torch.Tensor,
+                generator: torch.Generator | Sequence[torch.Generator] | None = None) -> torch.Tensor:
         x = _check_image("radiance", radiance)
+        per_image = generator is not None and not isinstance(generator, torch.Generator)
+        if per_image:
+            generator = list(generator)
+            if len(generator) != x.shape[0]:
+                raise ValueError(f"generator: a sequence must hold one torch.Generator per image ({x.shape[0]}); "
+                                 f"got {len(generator)}")
         for name in self._STAGES:
             stage = getattr(self, name)
             if stage is None:
                 continue
-            x = stage(x, generator=generator) if _takes_generator(stage) else stage(x)
+            if not _takes_generator(stage):
+                x = stage(x)
+            elif per_image and not isinstance(stage, DetectorNoise):  # a custom stage: one image at a time
+                x = torch.cat([stage(x[i : i + 1], generator=g) for i, g in enumerate(generator)])
+            else:
+                x = stage(x, generator=generator)
         return x

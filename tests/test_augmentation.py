@@ -238,3 +238,78 @@ def test_cuda_matches_cpu():
     c = s(x, generator=torch.Generator().manual_seed(1))
     d = s.to("cuda")(x.cuda(), generator=torch.Generator().manual_seed(1))
     assert float((d.cpu() - c).abs().max()) <= 2.0  # counts: rounding of nearly equal radiances
+
+
+class _SeaImages(torch.utils.data.Dataset):
+    """Each item: one sea image drawn by the augmentation's own generator (what a user writes)."""
+
+    def __init__(self, aug):
+        self.aug = aug
+
+    def __len__(self):
+        return 6
+
+    def __getitem__(self, i):
+        return self.aug(torch.zeros(1, 1, 16, 20))[0], torch.utils.data.get_worker_info().id
+
+
+def _worker_images(seed):
+    aug = small(generator=torch.Generator().manual_seed(seed))
+    loader = torch.utils.data.DataLoader(_SeaImages(aug), batch_size=1, num_workers=2)
+    out = {0: [], 1: []}
+    for img, wid in loader:
+        out[int(wid)].append(img[0])
+    return out
+
+
+def test_dataloader_workers_draw_their_own_scenes():
+    """A generator seeded once and copied into 2 DataLoader workers: the workers' scenes differ
+    (each worker gets its own stream), and a second run with the same seed repeats them all."""
+    a = _worker_images(3)
+    assert len(a[0]) == len(a[1]) == 3
+    assert all(not torch.equal(x, y) for x in a[0] for y in a[1])
+    b = _worker_images(3)
+    assert all(torch.equal(x, y) for k in (0, 1) for x, y in zip(a[k], b[k]))
+    # the replay from kept parameters is unaffected (outside workers, from the instance's generator)
+    aug = small(generator=torch.Generator().manual_seed(3))
+    y = aug(torch.zeros(2, 1, 16, 20))
+    assert torch.equal(aug(torch.zeros(2, 1, 16, 20), params=aug._params), y)
+
+
+@pytest.mark.parametrize("dtype", [torch.float16, torch.bfloat16])
+@pytest.mark.parametrize("mode", ["replace", "composite"])
+def test_half_precision_input_is_refused(dtype, mode):
+    """float16 steps are 0.25 K near 290 K (rounding by up to 0.125 K, against a 0.05 K NETD) and hold integers
+    exactly only to 2048: the output cannot carry the result in the input's dtype."""
+    assert float(torch.tensor(290.0, dtype=torch.float16).nextafter(torch.tensor(300.0, dtype=torch.float16)) - 290.0) == 0.25
+    x = torch.zeros(1, 2 if mode == "composite" else 1, H, W, dtype=dtype)
+    with pytest.raises(ValueError, match=r"input: dtype .*float32"):
+        RandomSeaBackground(mode=mode, output="brightness_temperature")(x)
+
+
+@pytest.mark.parametrize("bad", [2.0, -0.1, float("nan")])
+def test_alpha_outside_the_unit_interval_is_refused(bad):
+    x = torch.zeros(2, 2, H, W)
+    x[:, 0] = 300.0
+    x[1, 1, 3, 4] = bad
+    with pytest.raises(ValueError, match=r"alpha \(input channel 1.*\[0, 1\]"):
+        RandomSeaBackground(mode="composite", output="radiance")(x)
+    x[1, 1, 3, 4] = 1.0  # the edges of the range are fine
+    RandomSeaBackground(mode="composite", output="radiance")(x)
+
+
+@pytest.mark.parametrize("altitude", [(0.5, 100.0), (10.0, 6000.0), 1.0])
+def test_altitudes_outside_the_path_tables_are_refused(altitude):
+    """The path tables cover camera altitudes 2 m – 5 km: with the path on, a range leaving them is
+    refused at construction (naming altitude_m and the allowed range); with path=False the
+    sampler's wider 0.5 m – 20 km stays allowed."""
+    lo, hi = rs.atmosphere.load_path("tropical").altitude_range_m
+    assert (lo, hi) == (2.0, 5000.0)
+    for make in (lambda **k: RandomSeaBackground(atmospheres=["tropical", "us_standard"], **k),
+                 lambda **k: SceneSampler(atmospheres=["tropical", "us_standard"], **k)):
+        with pytest.raises(ValueError, match=r"altitude_m.*\[2, 5000\] m"):
+            make(altitude_m=altitude)
+        make(altitude_m=altitude, path=False)
+        make(altitude_m=(2.0, 5000.0))
+    with pytest.raises(ValueError, match="altitude_m"):
+        SceneSampler(altitude_m=(0.1, 10.0), path=False)  # below the sampler's own 0.5 m

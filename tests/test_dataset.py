@@ -82,7 +82,8 @@ def test_torchrun(reference, tmp_path):
         '[scene]\natmospheres = ["tropical", "us_standard"]\nwind_speed = [2.0, 12.0]\nair_temperature = [285.0, 300.0]\n'
     )
     env = dict(os.environ, OMP_NUM_THREADS="1")
-    r = subprocess.run([sys.executable, "-m", "torch.distributed.run", "--nproc_per_node", "2", "--master_port", "29517",
+    # --standalone: a local rendezvous on a free port, so runs sharing a machine do not collide
+    r = subprocess.run([sys.executable, "-m", "torch.distributed.run", "--standalone", "--nproc_per_node", "2",
                         str(ROOT / "pipelines" / "generate_dataset.py"), "--config", str(cfg), "--out", str(tmp_path / "o"),
                         "--no-progress"], capture_output=True, text=True, env=env, timeout=300)
     assert r.returncode == 0, r.stderr[-3000:]
@@ -161,6 +162,18 @@ def test_invalid_configs_fail_before_any_work(patch, key, tmp_path):
     with pytest.raises(ValueError, match=key.replace(".", r"\.")):
         generate(cfg, tmp_path / "out", progress=False)
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("altitude", [[0.5, 20.0], [100.0, 8000.0]])
+def test_altitudes_outside_the_path_tables_fail_before_any_work(altitude, tmp_path):
+    """With the path on (the default), scene.altitude_m must stay within the path tables' 2 m – 5 km;
+    with path = false the sampler's wider 0.5 m – 20 km is allowed."""
+    cfg = dict(CFG, scene=dict(CFG["scene"], altitude_m=altitude))
+    with pytest.raises(ValueError, match=r"scene\.altitude_m.*\[2, 5000\] m"):
+        generate(cfg, tmp_path / "out", progress=False)
+    assert not (tmp_path / "out").exists()
+    off = resolve_config(dict(cfg, scene=dict(cfg["scene"], path=False)))
+    assert off["scene"]["altitude_m"] == altitude and off["scene"]["path"] is False
 
 
 def test_resume_refuses_another_config(reference, tmp_path):

@@ -385,3 +385,36 @@ def test_cpu_generator_gives_the_same_noise_on_cuda():
 def test_bad_arguments_raise_value_error_naming_the_argument(make, name):
     with pytest.raises(ValueError, match=name):
         make()
+
+
+@pytest.mark.parametrize("band", [LWIR, MWIR], ids=["LWIR", "MWIR"])
+def test_detector_noise_std_is_netd_times_the_exact_slope_per_pixel(dtype, band):
+    """Same generator, same draws z: y − L = NETD · dL/dT(T) · z pixel by pixel, with dL/dT the
+    band sum of ∂B/∂T (noise_equivalent_radiance) at each pixel's temperature, from 100 K to
+    1200 K (above the sensor's 499 K table, too); below 100 K, at 100 K."""
+    T = torch.cat([torch.linspace(100.0, 1200.0, 4999, dtype=torch.float64), torch.tensor([60.0])])
+    L = band_radiance(T, band).to(dtype).view(1, 1, 100, 50)
+    z = torch.randn(L.shape, generator=gen(4), dtype=dtype)
+    netd = 10.0  # σ is linear in the NETD; a large one keeps the rounding of y = L + σz out of y − L
+    y = detector_noise(L, netd, band=band, generator=gen(4))
+    ok = z.abs() > 0.1
+    sigma = ((y - L) / z)[ok].double()
+    want = noise_equivalent_radiance(netd, T.clamp_min(100.0), band).view(L.shape)[ok]
+    assert float(((sigma - want) / want).abs().max()) < 3e-5
+
+
+def test_detector_noise_per_image_generators_match_each_image_alone(dtype):
+    """A sequence of generators, one per image: the batch equals each image noised alone with its
+    own generator, bit for bit (the noise of an image does not depend on its batch)."""
+    L = scene(dtype, "cpu", B=3, H=17, W=23)
+    batch = detector_noise(L, generator=[gen(10), gen(11), gen(12)])
+    alone = torch.cat([detector_noise(L[i : i + 1], generator=gen(10 + i)) for i in range(3)])
+    assert torch.equal(batch, alone)
+    assert not torch.equal(batch[0], batch[1] - L[1] + L[0])
+    sensor = SensorModel.typical_lwir()
+    a = sensor(L, generator=[gen(1), gen(2), gen(3)])
+    assert torch.equal(a, sensor(L, generator=[gen(1), gen(2), gen(3)]))
+    with pytest.raises(ValueError, match="generator"):
+        sensor(L, generator=[gen(1), gen(2)])
+    with pytest.raises(ValueError, match="generator"):
+        detector_noise(L, generator=[gen(1)])
