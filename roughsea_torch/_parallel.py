@@ -57,6 +57,9 @@ def map_chunks(fn: Callable[[Any], T], items: Sequence[Any], device: torch.devic
 
     def run(x: Any) -> T:
         _local.worker = True
+        # torch sets a thread's OpenMP team size lazily, on its first parallel call, to the last
+        # value anyone set; trigger that first, or it would undo the setting below
+        torch.get_num_threads()
         torch.set_num_threads(1)
         try:
             with torch.inference_mode(inference), torch.set_grad_enabled(grad):

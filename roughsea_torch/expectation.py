@@ -45,6 +45,7 @@ from typing import Any, Callable
 import numpy as np
 import torch
 
+from ._parallel import map_chunks
 from ._validation import as_tensor, check_finite_range, check_same_device, resolve_dtype_device
 from .optics import _fresnel_terms, split_refractive_index
 from .sky import ConstantSky, TabulatedSky, as_sky, select_sky
@@ -346,13 +347,14 @@ def _sky_terms(
         if idx.numel() == 0:
             continue
         step = max(1, q.chunk // ((3 if split else 1) * q.outer * q.inner))
-        parts_s, parts_r = [], []
-        for i in range(0, idx.numel(), step):
-            sel = idx[i : i + step]
+
+        def one(sel: torch.Tensor, split: bool = split) -> tuple[torch.Tensor, torch.Tensor]:
             i_s, i_r = _sky_numerator(g.take(sel), n[sel], k[sel], _sky_chunk(sky_fn, shape, sel, device), q, split)
-            parts_s.append(i_s / D[sel])
-            parts_r.append(i_r / D[sel])
-        vs, vr = torch.cat(parts_s), torch.cat(parts_r)
+            return i_s / D[sel], i_r / D[sel]
+
+        # chunks on worker threads of one intra-op thread each (roughsea_torch._parallel)
+        parts = map_chunks(one, [idx[i : i + step] for i in range(0, idx.numel(), step)], device)
+        vs, vr = torch.cat([s for s, _ in parts]), torch.cat([r for _, r in parts])
         if idx.numel() == total:
             out_s, out_r = vs, vr
         else:
@@ -407,7 +409,10 @@ def _run_chunked(
     step = max(1, q.chunk // max(per_eval_points, 1))
     if total <= step:
         return fn(slice(0, total)).reshape(batch_shape)
-    parts = [fn(slice(i, min(i + step, total))) for i in range(0, total, step)]
+    # independent chunks on worker threads of one intra-op thread each (no OpenMP barrier between
+    # the many operations of a chunk; roughsea_torch._parallel); the chunks do not depend on the
+    # thread count, so neither do the results
+    parts = map_chunks(fn, [slice(i, min(i + step, total)) for i in range(0, total, step)], device)
     return torch.cat(parts).reshape(batch_shape)
 
 

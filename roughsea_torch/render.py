@@ -148,14 +148,7 @@ class SeaScene:
         if path is not False and not callable(path):
             raise ValueError(f"path must be None, a bool, an atmosphere name or an AtmosphericPath; got {path!r}")
         self.path = path or None
-        # sky pixels of a named atmosphere with its own path on: the sky seen from the camera's
-        # altitude, continuous with the sea's horizon row (rays between the horizon dip and the
-        # horizontal cross the same lowest air); otherwise the sky seen from sea level
-        self.observer_sky = None
-        if self.atmosphere is not None and self.path is not None and getattr(self.path, "name", None) == self.atmosphere:
-            from .atmosphere import load_observer_sky
-
-            self.observer_sky = load_observer_sky(self.atmosphere, self.band, dtype=torch.float64)
+        self._observer_skies: dict[Any, Any] = {}
         if air_temperature is not None:
             if self.atmosphere is None:
                 raise ValueError("air_temperature needs a named atmosphere (sky='<name>'); scale a custom sky yourself")
@@ -166,6 +159,22 @@ class SeaScene:
         self.air_temperature = air_temperature
         self.refractive_index = refractive_index
         self.shadowing = shadowing
+
+    @property
+    def observer_sky(self) -> Any:
+        """The sky of the sky pixels when it is seen from the camera's altitude: with a named
+        atmosphere and its own path on (``atmosphere.load_observer_sky``), continuous with the
+        sea's horizon row (rays between the horizon dip and the horizontal cross the same lowest
+        air); else None (the sky seen from sea level). Follows the scene's current fields."""
+        if self.atmosphere is None or self.path is None or getattr(self.path, "name", None) != self.atmosphere:
+            return None
+        key = (self.atmosphere, self.band)
+        if key not in self._observer_skies:
+            from .atmosphere import load_observer_sky
+
+            self._observer_skies.clear()
+            self._observer_skies[key] = load_observer_sky(self.atmosphere, self.band, dtype=torch.float64)
+        return self._observer_skies[key]
 
     @property
     def batch_size(self) -> int:

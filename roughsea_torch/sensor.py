@@ -545,7 +545,8 @@ def radiance_to_counts(radiance: torch.Tensor, gain: float, offset: float, bits:
     c = torch.addcmul(scalars[0], radiance, scalars[1])  # gain · L + offset in one pass
     if rounding:
         c = _round_ste(c) if c.requires_grad else c.round_()
-    return c.clamp_(0.0, float(2**bits - 1)) if not c.requires_grad else c.clamp(0.0, float(2**bits - 1))
+    # + 0.0: a count rounded from a tiny negative value is −0.0, which clamp keeps; counts are ≥ +0
+    return c.clamp_(0.0, float(2**bits - 1)).add_(0.0) if not c.requires_grad else c.clamp(0.0, float(2**bits - 1)) + 0.0
 
 
 def counts_to_radiance(counts: torch.Tensor, gain: float, offset: float) -> torch.Tensor:

@@ -30,10 +30,13 @@ def varied_cameras(dtype, H=64, W=80):
 
 
 # Measured worst relative errors of the table against per-pixel evaluation over these scenes (sea
-# pixels; float32 / float64): 7e-7 / 3.5e-7 with a callable sky, 2.0e-6 / 1.3e-6 with the LOWTRAN sky
-# and the path (the path table is read per table row, not per pixel); sky pixels 4.5e-7 / 9e-8.
-SEA_TOL = {"fn": 2e-6, "midlatitude_summer": 4e-6}
-SKY_TOL = 1e-6
+# pixels; float32 / float64): 7e-7 / 3.7e-7 with a callable sky, 7e-7 / 3.7e-7 with the LOWTRAN sky
+# and the path (the path table is read per table row, not per pixel). Sky pixels: 4.5e-7 with a
+# callable sky; with the sky from the camera's altitude 4.2e-5 (0.003 K) in the row at the local
+# horizontal, where it has a square-root edge (rays just below it pass a tangent point near the
+# camera), 1e-6 elsewhere.
+SEA_TOL = {"fn": 2e-6, "midlatitude_summer": 2e-6}
+SKY_TOL = {"fn": 1e-6, "midlatitude_summer": 1e-4}
 
 
 @pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
@@ -59,7 +62,7 @@ def test_table_render_matches_direct_per_pixel_evaluation(dtype, anisotropic, sk
         assert table.shape == (5, 1, 64, 80) and table.dtype == dtype
         rel = (table - direct).abs() / direct.abs()
         assert rel[sea].max() <= SEA_TOL[sky_kind]
-        assert rel[~sea].max() <= SKY_TOL
+        assert rel[~sea].max() <= SKY_TOL[sky_kind]
 
 
 def test_horizon_depression_and_distance_on_a_sphere():
