@@ -1,0 +1,60 @@
+"""Chunks on worker threads (roughsea_torch._parallel): the same numbers whatever the thread
+count, the caller's thread settings and autograd mode respected."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+import torch
+
+import roughsea_torch as rs
+
+
+@pytest.fixture
+def two_threads():
+    old = torch.get_num_threads()
+    torch.set_num_threads(2)
+    yield
+    torch.set_num_threads(old)
+
+
+def _scene(wind):
+    return rs.SeaScene(wind_speed=wind, wind_direction=torch.tensor([0.1, 0.9, 2.0, -1.0]),
+                       sea_temperature=torch.tensor([285.0, 290.0, 295.0, 300.0]))
+
+
+def _cams():
+    return rs.make_camera(24, 32, altitude_m=torch.tensor([10.0, 20.0, 50.0, 200.0]),
+                          pitch_deg=torch.tensor([-2.0, -4.0, -8.0, -1.0]), dtype=torch.float64)
+
+
+def test_images_do_not_depend_on_the_thread_count(two_threads):
+    wind = torch.tensor([3.0, 6.0, 9.0, 12.0])
+    two = rs.render(_cams(), _scene(wind), chunk=1)
+    torch.set_num_threads(1)
+    one = rs.render(_cams(), _scene(wind), chunk=1)
+    assert torch.equal(one, two)
+
+
+def test_caller_and_new_threads_keep_their_thread_count(two_threads):
+    rs.render(_cams(), _scene(torch.tensor([3.0, 6.0, 9.0, 12.0])), chunk=1)
+    assert torch.get_num_threads() == 2
+    seen = []
+    t = threading.Thread(target=lambda: seen.append(torch.get_num_threads()))
+    t.start()
+    t.join()
+    assert seen == [2]  # workers restore torch's default for new threads
+
+
+def test_autograd_mode_reaches_the_workers(two_threads):
+    wind = torch.tensor([3.0, 6.0, 9.0, 12.0], dtype=torch.float64, requires_grad=True)
+    from roughsea_torch._parallel import map_chunks
+
+    with torch.no_grad():  # no graph is recorded in the workers either
+        assert map_chunks(lambda _: torch.is_grad_enabled(), [0, 1, 2], "cpu") == [False] * 3
+    assert map_chunks(lambda _: torch.is_grad_enabled(), [0, 1, 2], "cpu") == [True] * 3
+    (g2,) = torch.autograd.grad(rs.render(_cams(), _scene(wind), chunk=1).sum(), wind)
+    torch.set_num_threads(1)
+    (g1,) = torch.autograd.grad(rs.render(_cams(), _scene(wind), chunk=1).sum(), wind)
+    assert torch.equal(g1, g2) and bool((g1 != 0).all())
