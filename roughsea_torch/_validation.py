@@ -10,6 +10,7 @@ import math
 from numbers import Number
 from typing import Any
 
+import numpy as np
 import torch
 
 __all__ = ["resolve_dtype_device", "as_tensor", "check_finite_range", "check_same_device", "per_batch"]
@@ -30,22 +31,48 @@ def check_same_device(**items: Any) -> torch.device | None:
     return next(iter(unique)) if unique else None
 
 
+def _float_dtype(d: Any) -> torch.dtype | None:
+    """The real floating torch dtype a tensor/numpy dtype stands for (complex → its real part);
+    None for integer and boolean dtypes, which do not promote."""
+    if isinstance(d, np.dtype):
+        if d.kind == "c":
+            return torch.float64 if d.itemsize >= 16 else torch.float32
+        if d.kind != "f":
+            return None
+        return {2: torch.float16, 4: torch.float32}.get(d.itemsize, torch.float64)
+    if d.is_complex:
+        return torch.float64 if d == torch.complex128 else torch.float32
+    return d if d.is_floating_point else None
+
+
 def resolve_dtype_device(**items: Any) -> tuple[torch.dtype, torch.device]:
     """Working dtype and device of a call.
 
-    The dtype is the promotion of the floating (or complex, taken as its real part) tensor
-    arguments; Python numbers do not promote. Without any floating tensor the default dtype
-    (``torch.get_default_dtype()``) is used. Devices must agree.
+    The dtype is the promotion of the floating (or complex, taken as its real part) tensor and
+    numpy-array arguments: a numpy float64 array gives float64, a float32 array float32, as a
+    tensor would. Numpy scalars (``np.float64(0.3)``) behave as in torch's own type promotion:
+    beside a tensor or array they do not promote (like Python numbers); alone they give their
+    dtype, as ``torch.as_tensor`` would. Python numbers never promote. Without any of these the
+    default dtype (``torch.get_default_dtype()``) is used. Devices must agree.
     """
     device = check_same_device(**items)
-    dtype: torch.dtype | None = None
-    for t in _tensors(items).values():
-        d = t.dtype
-        if d.is_complex:
-            d = torch.float64 if d == torch.complex128 else torch.float32
-        elif not d.is_floating_point:
+    strong: torch.dtype | None = None
+    weak: torch.dtype | None = None
+    for v in items.values():
+        if isinstance(v, torch.Tensor):
+            d = _float_dtype(v.dtype)
+        elif isinstance(v, np.ndarray):
+            d = _float_dtype(v.dtype)
+        elif isinstance(v, np.generic):
+            d = _float_dtype(v.dtype)
+            if d is not None:
+                weak = d if weak is None else torch.promote_types(weak, d)
             continue
-        dtype = d if dtype is None else torch.promote_types(dtype, d)
+        else:
+            continue
+        if d is not None:
+            strong = d if strong is None else torch.promote_types(strong, d)
+    dtype = strong if strong is not None else weak
     if dtype is None:
         dtype = torch.get_default_dtype()
     if dtype not in (torch.float32, torch.float64):
@@ -62,7 +89,12 @@ def as_tensor(x: Any, dtype: torch.dtype, device: torch.device) -> torch.Tensor:
 
 def per_batch(name: str, x: Any, n: int, dtype: torch.dtype, device: torch.device | None) -> torch.Tensor:
     """A float or a tensor of shape () or (n,) as a tensor of shape (n,): one value per image."""
-    t = x.to(dtype=dtype, device=device) if isinstance(x, torch.Tensor) else torch.tensor(float(x), dtype=dtype, device=device)
+    if isinstance(x, torch.Tensor):
+        t = x.to(dtype=dtype, device=device)
+    elif isinstance(x, np.ndarray):  # a numpy (B,) array is one value per image, as a tensor is
+        t = torch.as_tensor(x, dtype=dtype, device=device)
+    else:
+        t = torch.tensor(float(x), dtype=dtype, device=device)
     if t.ndim == 0:
         return t.expand(n)
     if t.shape != (n,):

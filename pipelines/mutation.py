@@ -1,0 +1,548 @@
+"""Mutation testing of roughsea_torch: does the test suite notice a wrong physical number?
+
+Each mutant changes one thing in one function of the package: a numeric constant (×1.01 for a
+float, ±1 for an int in arithmetic), an arithmetic operator (+ ↔ −, * ↔ /), an exponent (+1), a
+comparison (< ↔ <=, > ↔ >=, == ↔ !=), a dropped term (a ± b → a), a dropped unary minus, a dropped
+degree→radian conversion (``deg2rad``/``radians``/``* d2r``), or two swapped arguments
+(``atan2``, ``where``, ``minimum``/``maximum`` …). For every mutant the module's test files (the
+mapping below) run with ``pytest -x -q`` in a COPY of the repository, with ``PYTHONPATH`` at the
+copy (checked: the copy's package is the one imported), so /work/main is never touched. Mutants run
+on ``--workers`` processes in parallel (one private copy each), with a timeout per mutant.
+
+Outcomes: killed (a test failed), survived (all passed), timeout, error (the mutant could not be
+imported: counted as killed, pytest reports it as an error). Tests that already fail on the
+unmutated copy are deselected first (others may be mid-rewrite), and the report says so.
+
+Results are merged by module into ``docs/mutation.md`` (the state is a comment block at its end),
+rewritten from every module's latest results: per-module and overall kill rates, and every survivor
+with its diff line and a note (the notes live in ``NOTES`` below, keyed by module and diff line).
+
+    python pipelines/mutation.py --modules slopes optics radiometry --max-per-module 25
+    python pipelines/mutation.py --modules render geometry sky atmosphere --max-per-module 25
+    python pipelines/mutation.py --list --modules expectation        # show the mutants only
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import copy
+import json
+import os
+import random
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PKG = "roughsea_torch"
+
+CORE = ["tests/test_published_values.py", "tests/test_model_physics.py", "tests/test_torch_core.py"]
+# module → test files, fastest and most discriminating first (``-x`` stops at the first failure)
+TESTS: dict[str, list[str]] = {
+    "slopes": CORE + ["tests/test_reference_skies_and_indices.py", "tests/test_stability.py", "tests/test_agreement.py"],
+    "optics": CORE + ["tests/test_reference_skies_and_indices.py", "tests/test_stability.py", "tests/test_agreement.py"],
+    "radiometry": ["tests/test_published_values.py", "tests/test_brightness_temperature_lookup.py", "tests/test_model_physics.py",
+                   "tests/test_torch_core.py", "tests/test_stability.py", "tests/test_pixel_derivative.py",
+                   "tests/test_reference_skies_and_indices.py", "tests/test_numpy_input_dtype.py"],
+    "expectation": CORE + ["tests/test_reference_skies_and_indices.py", "tests/test_stability.py", "tests/test_agreement.py"],
+    "_validation": CORE + ["tests/test_numpy_input_dtype.py", "tests/test_stability.py"],
+    "sensitivity": ["tests/test_pixel_derivative.py", "tests/test_render.py"],
+    "reference/planck": ["tests/test_published_values.py", "tests/test_model_physics.py", "tests/test_reference_skies_and_indices.py"],
+    "reference/fresnel": ["tests/test_published_values.py", "tests/test_model_physics.py", "tests/test_agreement.py"],
+    "reference/slopes": ["tests/test_published_values.py", "tests/test_model_physics.py", "tests/test_agreement.py"],
+    "reference/rough_sea": ["tests/test_published_values.py", "tests/test_model_physics.py",
+                            "tests/test_reference_skies_and_indices.py", "tests/test_agreement.py"],
+    # being rewritten by others at the time of writing; mapped so that a later run works
+    "render": ["tests/test_scene_radiometry_and_camera_pose.py", "tests/test_render.py", "tests/test_augmentation.py"],
+    "geometry": ["tests/test_scene_radiometry_and_camera_pose.py", "tests/test_render.py"],
+    "sky": ["tests/test_torch_core.py", "tests/test_reference_skies_and_indices.py", "tests/test_render.py", "tests/test_atmosphere.py"],
+    "atmosphere": ["tests/test_atmosphere.py", "tests/test_reference_skies_and_indices.py", "tests/test_render.py"],
+    "augmentation": ["tests/test_augmentation.py"],
+    "sensor": ["tests/test_sensor.py"],
+    "dataset": ["tests/test_dataset.py", "tests/test_scene_radiometry_and_camera_pose.py"],
+}
+MODULE_ALIASES = {"reference": ["reference/planck", "reference/fresnel", "reference/slopes", "reference/rough_sea"],
+                  "reference/*": ["reference/planck", "reference/fresnel", "reference/slopes", "reference/rough_sea"]}
+
+# Notes on survivors, keyed by (module, diff line): why the mutant is equivalent or changes no
+# physical number, or which test now kills it. Filled in after reading each survivor.
+# A key is the full diff line, or "L<line> <original>" for every mutant of that expression.
+NOTES: dict[tuple[str, str], str] = {
+    ('optics', 'L222 1e-6'):
+        'equivalent: the finite-difference step of the Gauss–Newton Jacobian in band_refractive_index; ×1.01 changes the converged (n, k) by < 1e-12 (the fit is checked by test_published_values::test_lwir_band_index_is_the_least_squares_optimum, which it still passes).',
+    ('optics', 'L240 _fresnel_terms(c, nn[..., None], kk[..., None])'):
+        'changes only worst(), the test that chooses between the fitted and the averaged index; both candidates are right in their band and the choice stays the same for LWIR and MWIR (test_band_index_in_mwir_is_the_planck_weighted_average checks both choices). Not a physical number; a band where the choice flips would kill it.',
+    ('radiometry', 'L141 head + ("flat",)'):
+        'equivalent: part of a cache key; the other keys still differ from it in length and content.',
+    ('radiometry', 'L282 1e-13 * t'):
+        'equivalent: the Newton stopping test of the far-from-table inversion becomes stricter (1e-13/T instead of 1e-13·T); the iteration stops at the 60-step cap with the same value to rounding.',
+    ('radiometry', 'L335 1'):
+        'equivalent: one more log-L bucket past the end of the brightness-temperature table (never reached: indices are clamped to the last bucket).',
+    ('radiometry', 'L360 Ld <= Ln[-1]'):
+        "equivalent: a radiance exactly at the table's last node (500 K) goes to the Newton inversion instead of the table; both give 500 K to 1e-12 (test_tabulated_response_and_table_edges).",
+}
+NOTES[("expectation", "L269 A * sqrt_1mB2")] = (
+    "accuracy only: it moves the sky disc's outer panel limits where the Gaussian window (7.5σ) ends "
+    "inside the disc, narrowing the window to about 5σ near nadir; measured over W = 0, 5, 20 m/s "
+    "(isotropic and anisotropic), θ̂ = 0–89°: R_a changes by at most 5.9e-9 relative, below the "
+    "float64 accuracy target (1e-6) and of the order of the documented float64 error (6.8e-9). "
+    "No physical number changes at the accuracy the library promises.")
+NOTES[("expectation", "L291 torch.maximum(shift(u_plus), d_m)")] = "equivalent: maximum is symmetric in its arguments."
+NOTES[("reference/fresnel", "L68 1.0")] = (
+    "equivalent: np.minimum(c, 1.01) where the line before has rejected c > 1 + 1e-12 (the clamp only "
+    "removes rounding above 1).")
+NOTES[("reference/planck", "L103 400.0")] = (
+    "equivalent for every radiance inside the reference's documented 150–400 K domain: the upper end "
+    "of the brentq bracket (same root); only the domain check moves from 400 K to 404 K.")
+NOTES[("reference/fresnel", "L68 np.minimum(c, 1.0)")] = "equivalent: minimum is symmetric in its arguments."
+NOTES[("reference/rough_sea", "L175 0.25 * tr * tr")] = (
+    "accuracy only: the reference's outer truncation angle θ_max (N_RMS times the largest rms slope) "
+    "becomes larger; integrating further into the Gaussian tail changes nothing beyond scipy's epsrel.")
+NOTES[("reference/rough_sea", "L247 self.ph + k * HALF_PI")] = (
+    "accuracy only: breakpoints handed to scipy's adaptive quad (where the shadow/sky edges enter); "
+    "without them quad subdivides adaptively to the same epsrel.")
+NOTES[("reference/rough_sea", "L282 0.5 * (HALF_PI - self.th)")] = (
+    "accuracy only: a breakpoint hint of scipy's adaptive quad moves; the value is the same to epsrel.")
+NOTES[("reference/rough_sea", "L389 1e-12")] = (
+    "accuracy only: the inner tolerance of an integral whose exact value is 0 (used only there).")
+STATE_BEGIN, STATE_END = "<!-- mutation-state (read by pipelines/mutation.py; keep)", "mutation-state -->"
+
+SKIP_CALLS = {"check_finite_range", "ValueError", "TypeError", "RuntimeError", "print", "warn", "per_batch",
+              "_check_angles", "_check_slopes", "_check_band", "_check_slope_arrays", "_check_view", "_check_radiance"}
+SKIP_FUNCS = {"__repr__", "__post_init__", "extra_repr", "fmt", "__hash__", "main"}
+SWAP_CALLS = {"atan2", "where", "minimum", "maximum", "logaddexp", "hypot", "arctan2", "clamp", "complex", "interp",
+              "broadcast_arrays", "searchsorted", "_fresnel_terms", "_planck", "_planck_dT", "from_variances",
+              "SlopeStatistics", "split_refractive_index", "_geometry", "band_radiance", "_band_scalar"}
+DEG_CALLS = {"deg2rad", "radians"}
+
+
+@dataclass
+class Mutant:
+    module: str
+    index: int
+    kind: str
+    line: int
+    function: str
+    original: str
+    mutated: str
+    status: str = "pending"
+    seconds: float = 0.0
+    killed_by: str = ""
+
+    @property
+    def diff(self) -> str:
+        return f"L{self.line} {self.original}  →  {self.mutated}"
+
+
+def module_path(module: str) -> Path:
+    return Path(PKG) / (module + ".py")
+
+
+# -- mutant generation -------------------------------------------------------------------------------
+
+
+class _Finder(ast.NodeVisitor):
+    """Collects (node, kind, new_node) candidates inside functions, outside validation/messages."""
+
+    def __init__(self) -> None:
+        self.out: list[tuple[ast.AST, str, ast.AST, str]] = []
+        self.func: list[str] = []
+        self.skip = 0
+
+    def generic_visit(self, node: ast.AST) -> None:
+        super().generic_visit(node)
+
+    def visit_FunctionDef(self, node: ast.FunctionDef) -> None:
+        if node.name in SKIP_FUNCS:
+            return
+        self.func.append(node.name)
+        body = node.body
+        if body and isinstance(body[0], ast.Expr) and isinstance(getattr(body[0], "value", None), ast.Constant):
+            body = body[1:]  # docstring
+        for stmt in body:
+            self.visit(stmt)
+        self.func.pop()
+
+    visit_AsyncFunctionDef = visit_FunctionDef
+
+    def visit_ClassDef(self, node: ast.ClassDef) -> None:
+        for stmt in node.body:
+            if isinstance(stmt, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                self.visit(stmt)
+
+    def _skip_subtree(self, node: ast.AST) -> None:
+        return  # do not descend
+
+    visit_Raise = _skip_subtree
+    visit_Assert = _skip_subtree
+    visit_JoinedStr = _skip_subtree
+
+    def visit_Call(self, node: ast.Call) -> None:
+        name = _call_name(node.func)
+        if name in SKIP_CALLS:
+            return
+        if self.func and name in DEG_CALLS and len(node.args) == 1:
+            self.add(node, "deg2rad dropped", node.args[0])
+        if self.func and name in SWAP_CALLS and len(node.args) >= 2:
+            i, j = (1, 2) if name == "where" and len(node.args) == 3 else (0, 1)
+            new = copy.deepcopy(node)
+            new.args[i], new.args[j] = new.args[j], new.args[i]
+            if ast.dump(new.args[i]) != ast.dump(new.args[j]):
+                self.add(node, "arguments swapped", new)
+        self.generic_visit(node)
+
+    def visit_Subscript(self, node: ast.Subscript) -> None:
+        self.visit(node.value)  # indices and slices are not physical numbers
+
+    def visit_AnnAssign(self, node: ast.AnnAssign) -> None:
+        if node.value is not None:
+            self.visit(node.value)
+
+    def visit_Constant(self, node: ast.Constant) -> None:
+        if not self.func or isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
+            return
+        if isinstance(node.value, float):
+            if node.value != 0.0:
+                self.add(node, "constant ×1.01", ast.Constant(node.value * 1.01))
+        elif getattr(node, "_arith", False):
+            self.add(node, "constant +1", ast.Constant(node.value + 1))
+
+    def visit_BinOp(self, node: ast.BinOp) -> None:
+        for side in (node.left, node.right):
+            if isinstance(side, ast.Constant):
+                side._arith = True  # type: ignore[attr-defined]
+        if self.func:
+            swap = {ast.Add: ast.Sub, ast.Sub: ast.Add, ast.Mult: ast.Div, ast.Div: ast.Mult}
+            op = type(node.op)
+            if op in swap:
+                new = copy.deepcopy(node)
+                new.op = swap[op]()
+                self.add(node, "operator swapped", new)
+            if op in (ast.Add, ast.Sub) and not _is_const(node.left) and not _is_const(node.right):
+                self.add(node, "term dropped", copy.deepcopy(node.left))
+            if op is ast.Pow and isinstance(node.right, ast.Constant) and isinstance(node.right.value, (int, float)):
+                new = copy.deepcopy(node)
+                new.right = ast.Constant(node.right.value + 1)
+                self.add(node, "exponent changed", new)
+                node.right._arith = False  # type: ignore[attr-defined]  # covered by the line above
+            if op is ast.Mult and any(_name(s) in {"d2r", "DEG"} for s in (node.left, node.right)):
+                keep = node.left if _name(node.right) in {"d2r", "DEG"} else node.right
+                self.add(node, "deg2rad dropped", copy.deepcopy(keep))
+        self.generic_visit(node)
+
+    def visit_UnaryOp(self, node: ast.UnaryOp) -> None:
+        if self.func and isinstance(node.op, ast.USub) and not isinstance(node.operand, ast.Constant):
+            self.add(node, "unary minus dropped", copy.deepcopy(node.operand))
+        self.generic_visit(node)
+
+    def visit_Compare(self, node: ast.Compare) -> None:
+        if self.func and len(node.ops) == 1:
+            flip = {ast.Lt: ast.LtE, ast.LtE: ast.Lt, ast.Gt: ast.GtE, ast.GtE: ast.Gt, ast.Eq: ast.NotEq, ast.NotEq: ast.Eq}
+            op = type(node.ops[0])
+            if op in flip:
+                new = copy.deepcopy(node)
+                new.ops = [flip[op]()]
+                self.add(node, "comparison changed", new)
+        self.generic_visit(node)
+
+    def add(self, node: ast.AST, kind: str, new: ast.AST) -> None:
+        self.out.append((node, kind, new, self.func[-1] if self.func else "<module>"))
+
+
+def _call_name(f: ast.AST) -> str:
+    if isinstance(f, ast.Name):
+        return f.id
+    if isinstance(f, ast.Attribute):
+        return f.attr
+    return ""
+
+
+def _name(n: ast.AST) -> str:
+    return n.id if isinstance(n, ast.Name) else ""
+
+
+def _is_const(n: ast.AST) -> bool:
+    return isinstance(n, ast.Constant)
+
+
+def _replace(src: bytes, node: ast.AST, text: str) -> bytes:
+    """Replace the span of ``node`` (line/col offsets are UTF-8 byte offsets) with ``text``."""
+    lines = src.splitlines(keepends=True)
+    starts = [0]
+    for ln in lines:
+        starts.append(starts[-1] + len(ln))
+    a = starts[node.lineno - 1] + node.col_offset
+    b = starts[node.end_lineno - 1] + node.end_col_offset
+    return src[:a] + text.encode() + src[b:]
+
+
+def mutants_of(module: str, max_n: int, seed: int, root: Path = ROOT) -> tuple[list[Mutant], dict[int, bytes]]:
+    path = root / module_path(module)
+    src = path.read_bytes()
+    tree = ast.parse(src)
+    f = _Finder()
+    f.visit(tree)
+    seen: set[tuple[int, str]] = set()
+    cands = []
+    for node, kind, new, func in f.out:
+        original = ast.get_source_segment(src.decode(), node) or ast.unparse(node)
+        text = "(" + ast.unparse(new) + ")"
+        mutated = _replace(src, node, text)
+        try:
+            ast.parse(mutated)
+        except SyntaxError:
+            continue
+        key = (node.lineno, text + original)
+        if key in seen or mutated == src:
+            continue
+        seen.add(key)
+        cands.append((node.lineno, kind, func, " ".join(original.split()), " ".join(text.split()), mutated))
+    rng = random.Random(f"{seed}:{module}")
+    if len(cands) > max_n:
+        cands = rng.sample(cands, max_n)
+    cands.sort(key=lambda c: c[0])
+    muts, sources = [], {}
+    for i, (line, kind, func, orig, text, mutated) in enumerate(cands):
+        muts.append(Mutant(module, i, kind, line, func, orig, text))
+        sources[i] = mutated
+    return muts, sources
+
+
+# -- running ----------------------------------------------------------------------------------------
+
+
+def copy_tree(dst: Path) -> Path:
+    ignore = shutil.ignore_patterns(".venv", ".git", "__pycache__", "*.egg-info", "outputs", ".pytest_cache")
+    shutil.copytree(ROOT, dst, ignore=ignore)
+    return dst
+
+
+def env_for(copy_root: Path) -> dict[str, str]:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(copy_root)
+    env["OMP_NUM_THREADS"] = env["MKL_NUM_THREADS"] = "1"
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    return env
+
+
+def check_import(copy_root: Path) -> None:
+    out = subprocess.run([sys.executable, "-c", f"import {PKG}, {PKG}.reference; print({PKG}.__file__)"],
+                         cwd=copy_root, env=env_for(copy_root), capture_output=True, text=True, timeout=300)
+    where = Path(out.stdout.strip()).resolve() if out.returncode == 0 else None
+    if where is None or copy_root.resolve() not in where.parents:
+        raise SystemExit(f"the copy's package is not the one imported: {out.stdout.strip() or out.stderr[-500:]}")
+
+
+def pytest_cmd(tests: list[str], deselect: list[str], timeout: float | None = None) -> list[str]:
+    cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-p", "no:randomly", "-rfE",
+           "--no-header", *tests]
+    for d in deselect:
+        cmd += ["--deselect", d]
+    return cmd
+
+
+def run_tests(copy_root: Path, tests: list[str], deselect: list[str], timeout: float, stop_first: bool = True) -> tuple[str, float, str]:
+    cmd = pytest_cmd(tests, deselect)
+    if not stop_first:
+        cmd.remove("-x")
+    t0 = time.perf_counter()
+    try:
+        out = subprocess.run(cmd, cwd=copy_root, env=env_for(copy_root), capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return "timeout", time.perf_counter() - t0, ""
+    dt = time.perf_counter() - t0
+    failed = re.findall(r"^(?:FAILED|ERROR) (\S+)", out.stdout, re.M)
+    if out.returncode == 0:
+        return "survived", dt, ""
+    if failed:
+        return "killed", dt, "\n".join(failed)
+    tail = out.stdout.strip().splitlines()[-1:] or out.stderr.strip().splitlines()[-1:] or [""]
+    return "killed", dt, f"pytest exit {out.returncode}: {tail[0][:200]}"
+
+
+def baseline(copy_root: Path, tests: list[str]) -> tuple[list[str], float]:
+    """Test ids failing on the unmutated copy (deselected afterwards), and the run time."""
+    status, dt, failed = run_tests(copy_root, tests, [], timeout=3600, stop_first=False)
+    bad = [f for f in failed.splitlines() if "::" in f] if status != "survived" else []
+    return bad, dt
+
+
+def run_module(module: str, muts: list[Mutant], sources: dict[int, bytes], workers: list[Path], timeout_factor: float,
+               log) -> dict:
+    tests = [t for t in TESTS[module] if (ROOT / t).exists()]
+    rel = module_path(module)
+    bad, t_base = baseline(workers[0], tests)
+    log(f"[{module}] baseline {t_base:.0f} s on {len(tests)} test files; {len(bad)} failing before mutation (deselected)")
+    timeout = max(60.0, timeout_factor * t_base)
+    original = (workers[0] / rel).read_bytes()  # the copy's own text (the tree may change meanwhile)
+    free = list(workers)
+
+    def one(m: Mutant) -> Mutant:
+        w = free.pop()
+        try:
+            (w / rel).write_bytes(sources[m.index])
+            m.status, m.seconds, m.killed_by = run_tests(w, tests, bad, timeout)
+        finally:
+            (w / rel).write_bytes(original)
+            free.append(w)
+        log(f"  [{module} #{m.index}, {len(muts)} in this run] {m.status:8s} {m.seconds:5.0f} s  {m.kind}: {m.diff}")
+        return m
+
+    with ThreadPoolExecutor(len(workers)) as pool:
+        done = list(pool.map(one, muts))
+    return {"module": module, "tests": tests, "baseline_failing": bad, "baseline_seconds": t_base,
+            "timeout_seconds": timeout, "mutants": [asdict(m) for m in done], "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}
+
+
+# -- report -----------------------------------------------------------------------------------------
+
+
+def load_notes() -> dict[tuple[str, str], str]:
+    """NOTES with their "L<line> " prefixes removed: a note follows its expression when lines move."""
+    return {(mod, re.sub(r"^L\d+ ", "", key)): note for (mod, key), note in NOTES.items()}
+
+
+def load_state(md: Path, legacy: Path) -> dict:
+    """Every module's latest results: kept in the report itself (a comment block at its end), so
+    that a run on other modules merges into it."""
+    if md.exists():
+        text = md.read_text()
+        if STATE_BEGIN in text:
+            return json.loads(text.split(STATE_BEGIN, 1)[1].split(STATE_END, 1)[0])
+    if legacy.exists():  # results of a run of an earlier version of this script
+        return json.loads(legacy.read_text())
+    return {}
+
+
+def write_report(results: dict, md: Path) -> None:
+    notes = load_notes()
+    rows, surv = [], []
+    tot_k = tot_n = 0
+    for mod in sorted(results):
+        r = results[mod]
+        ms = [Mutant(**m) for m in r["mutants"]]
+        k = sum(m.status == "killed" for m in ms)
+        t = sum(m.status == "timeout" for m in ms)
+        s = [m for m in ms if m.status == "survived"]
+        n = len(ms)
+        tot_k += k + t
+        tot_n += n
+        rate = f"{100 * (k + t) / n:.0f} %" if n else "–"
+        rows.append(f"| `{mod}` | {n} | {k} | {t} | {len(s)} | {rate} | {len(r['baseline_failing'])} | {r['date']} |")
+        for m in s:
+            note = notes.get((mod, f"{m.original}  →  {m.mutated}")) or notes.get((mod, m.original), "(not yet reviewed)")
+            surv.append((mod, m, note))
+    lines = [
+        "# Mutation testing",
+        "",
+        "Generated by `pipelines/mutation.py` (merged per module; the state is the comment at the end). Each mutant",
+        "changes one physical number or operation in one function of the package (numeric constant ×1.01",
+        "or ±1, + ↔ −, * ↔ /, exponent +1, comparison flipped, term dropped, unary minus dropped, degree",
+        "→ radian conversion dropped, two arguments swapped) and runs the module's test files",
+        "(`TESTS` in the script) with `pytest -x` in a copy of the repository. Timeouts count as killed.",
+        "Tests failing before mutation (work in progress elsewhere) are deselected and counted in the",
+        "last column.",
+        "",
+        "| module | mutants | killed | timeout | survived | kill rate | failing before | run |",
+        "|---|---|---|---|---|---|---|---|",
+        *rows,
+        f"| **all** | {tot_n} | | | {len(surv)} | **{100 * tot_k / max(tot_n, 1):.0f} %** | | |",
+        "",
+        "Mutants are a deterministic sample (`--max-per-module`, `--seed`) of every candidate in the",
+        "module; `sensitivity.py` has no arithmetic to mutate (0 candidates; `tests/test_pixel_derivative.py`",
+        "checks it against closed forms). Swapping the arguments of a symmetric function (`maximum`,",
+        "`minimum`) is generated too and always survives (listed as equivalent). Re-run, e.g. after a rewrite:",
+        "",
+        "    python pipelines/mutation.py --modules render geometry sky atmosphere --max-per-module 16",
+        "    python pipelines/mutation.py --modules expectation --max-per-module 16 --only-survivors",
+        "",
+        "## Survivors",
+        "",
+    ]
+    if not surv:
+        lines.append("None.")
+    for mod, m, note in surv:
+        lines.append(f"- `{mod}` {m.function}() {m.kind}: `{m.diff}` — {note}")
+    lines += ["", STATE_BEGIN, json.dumps(results, indent=0, ensure_ascii=False), STATE_END]
+    md.write_text("\n".join(lines) + "\n")
+
+
+# -- main -------------------------------------------------------------------------------------------
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--modules", nargs="+", required=True, help=f"modules under {PKG}/ (e.g. slopes reference/planck; 'reference' = all four reference files)")
+    ap.add_argument("--max-per-module", type=int, default=25, help="mutants sampled per module (deterministic, --seed)")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--timeout-factor", type=float, default=2.5, help="timeout per mutant = factor × baseline run time (≥ 60 s)")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--only-survivors", action="store_true", help="re-run only the survivors recorded in the report (same --max-per-module and --seed)")
+    ap.add_argument("--list", action="store_true", help="print the mutants and exit")
+    ap.add_argument("--report-only", action="store_true", help="rewrite the report from its recorded state and exit")
+    ap.add_argument("--json", type=Path, default=ROOT / "docs" / "mutation.json", help=argparse.SUPPRESS)  # legacy state file
+    ap.add_argument("--report", type=Path, default=ROOT / "docs" / "mutation.md")
+    args = ap.parse_args(argv)
+
+    modules = []
+    for m in args.modules:
+        m = m.removeprefix(f"{PKG}/").removesuffix(".py")
+        modules += MODULE_ALIASES.get(m, [m])
+    for m in modules:
+        if m not in TESTS or not (ROOT / module_path(m)).exists():
+            ap.error(f"unknown module {m!r}; known: {', '.join(sorted(TESTS))}")
+
+    results = load_state(args.report, args.json)
+
+    def make_plan(root: Path) -> dict:
+        plan = {m: mutants_of(m, args.max_per_module, args.seed, root) for m in modules}
+        if args.only_survivors:  # the same sample (same seed), restricted to the recorded survivors
+            for m, (muts, src) in plan.items():
+                # matched by function and text, not line: the file may have moved since
+                old = {(x["function"], x["original"], x["mutated"]) for x in results.get(m, {}).get("mutants", []) if x["status"] == "survived"}
+                plan[m] = ([x for x in muts if (x.function, x.original, x.mutated) in old], src)
+        return plan
+
+    if args.report_only:
+        write_report(results, args.report)
+        return 0
+    if args.list:
+        for m, (muts, _) in make_plan(ROOT).items():
+            for x in muts:
+                print(f"{m:22s} {x.function:28s} {x.kind:20s} {x.diff}")
+        return 0
+
+    t0 = time.perf_counter()
+
+    def log(msg: str) -> None:
+        print(f"{time.perf_counter() - t0:6.0f} s  {msg}", flush=True)
+
+    with tempfile.TemporaryDirectory(prefix="roughsea_mutation_") as tmp:
+        workers = [copy_tree(Path(tmp) / f"w{i}") for i in range(args.workers)]
+        for w in workers:
+            check_import(w)
+        log(f"{len(workers)} copies of the repository in {tmp}; the copy's package is the one imported")
+        plan = make_plan(workers[0])  # mutants of the copied text: the tree may change meanwhile
+        for m, (muts, src) in plan.items():
+            if not muts:
+                continue
+            res = run_module(m, muts, src, workers, args.timeout_factor, log)
+            if args.only_survivors and m in results:  # update the re-run mutants in place
+                new = {(x["function"], x["original"], x["mutated"]): x for x in res["mutants"]}
+                res["mutants"] = [new.get((x["function"], x["original"], x["mutated"]), x) for x in results[m]["mutants"]]
+            results[m] = res
+            write_report(results, args.report)
+    write_report(results, args.report)
+    log(f"done; report in {args.report}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,50 @@
+"""``pixel_derivative`` (per-pixel d image / d parameter) against derivatives known in closed form:
+dL/dT of Planck's law integrated over the band (constants typed in), and d(a w²)/dw."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import torch
+from scipy import integrate
+
+import roughsea_torch as rs
+
+H, C, KB = 6.62607015e-34, 299792458.0, 1.380649e-23  # CODATA 2018
+
+
+def dplanck_band_dT(T: float, lo: float = 8e-6, hi: float = 12e-6) -> float:
+    """∫ ∂B_λ/∂T dλ, ∂B/∂T = B · x e^x / (T (e^x − 1)), x = hc/(λ k T)."""
+
+    def f(lam: float) -> float:
+        x = H * C / (lam * KB * T)
+        return 2 * H * C * C / lam**5 * x * math.exp(x) / (T * math.expm1(x) ** 2)
+
+    return integrate.quad(f, lo, hi, epsabs=0.0, epsrel=1e-12)[0]
+
+
+def test_pixel_derivative_of_band_radiance_images_is_planck_slope():
+    """Images L(T_b + offset) with one sea temperature per image (B,): each image's map is its own
+    dL/dT, and a scalar parameter shared by the images gives every pixel its slope."""
+    T = torch.tensor([280.0, 300.0], dtype=torch.float64, requires_grad=True)
+    offsets = torch.linspace(-5.0, 5.0, 12, dtype=torch.float64).reshape(1, 1, 3, 4)
+    images = rs.band_radiance(T[:, None, None, None] + offsets)
+    d = rs.pixel_derivative(images, T)
+    assert d.shape == images.shape
+    for b in range(2):
+        for k, off in enumerate(offsets.flatten().tolist()):
+            want = dplanck_band_dT(float(T[b].detach()) + off)
+            assert abs(float(d[b].flatten()[k]) / want - 1) < 1e-9
+    w = torch.tensor(3.0, dtype=torch.float64, requires_grad=True)
+    coeff = torch.arange(1.0, 7.0, dtype=torch.float64).reshape(1, 1, 2, 3)
+    torch.testing.assert_close(rs.pixel_derivative(coeff * w**2, w), coeff * 2 * 3.0, rtol=1e-14, atol=0)
+
+
+def test_pixel_derivative_unused_parameter_and_errors():
+    w = torch.tensor(2.0, requires_grad=True)
+    v = torch.tensor(5.0, requires_grad=True)
+    img = (v * torch.ones(1, 1, 2, 2)) ** 2
+    assert torch.equal(rs.pixel_derivative(img, w), torch.zeros_like(img))
+    with pytest.raises(ValueError, match="parameter"):
+        rs.pixel_derivative(img, torch.tensor(1.0))
