@@ -274,6 +274,8 @@ class TableSize:
             sharply with azimuth, and the spans read from the cameras' border start at the
             horizon, ζ = 0): W = 0 along the wind, 1.3e-4 with 21 nodes, 7e-6 with 41.
         fine_zenith, fine_azimuth: rows/columns of the fine table read by ``grid_sample``.
+        fine_azimuth_thin: columns of the fine table when a slope ellipse is thin (64 columns leave
+            views along the wind at W = 0 at 3e-5, 128 at 7e-6).
         fine_sky: rows of the sky block of the fine table, evenly spaced in the cosine of the ray's
             zenith over the span of the image's sky pixels.
         span: ``"pixels"`` (default): nodes only over the angles the image's sea pixels span;
@@ -283,11 +285,12 @@ class TableSize:
     zenith: int = 21
     azimuth: int = 7
     fine_zenith: int = 4096
-    fine_azimuth: int = 128
+    fine_azimuth: int = 64
     span: str = "pixels"
     azimuth_thin: int = 33
     fine_sky: int = 2048
     zenith_thin: int = 41
+    fine_azimuth_thin: int = 128
 
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):
@@ -295,7 +298,7 @@ class TableSize:
         for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin"):
             if int(getattr(self, name)) < 2:
                 raise ValueError(f"TableSize.{name} must be >= 2")
-        for name in ("fine_zenith", "fine_azimuth", "fine_sky"):
+        for name in ("fine_zenith", "fine_azimuth", "fine_sky", "fine_azimuth_thin"):
             if int(getattr(self, name)) < 4 * _EXT + 2:
                 raise ValueError(f"TableSize.{name} must be >= {4 * _EXT + 2}")
 
@@ -584,7 +587,7 @@ def render(
             img = sky_pix if img is None else torch.where(sea, img, sky_pix)
         img = img.reshape(B, 1, H, W)
         if output == "brightness_temperature":
-            return brightness_temperature(img.clamp_min(torch.finfo(dtype).tiny), scene.band)
+            return _kelvin(img, scene.band)
         return img
     if geometry is not None:
         altitude, radius = geometry.altitude_m, getattr(geometry, "earth_radius_m", earth_radius_m)
@@ -678,14 +681,13 @@ def _render_table(
     xz_t = torch.as_tensor(xz, dtype=torch.float64, device=device)
     Lz_t = torch.as_tensor(Lz, dtype=dtype, device=device)
     if not iso:
-        xp, Lp, ep = _lobatto_interp(nphi, table.fine_azimuth)
+        xp, Lp, ep = _lobatto_interp(nphi, max(table.fine_azimuth, table.fine_azimuth_thin) if thin else table.fine_azimuth)
         xp_t = torch.as_tensor(xp, dtype=torch.float64, device=device)
         Lp_t = torch.as_tensor(Lp, dtype=dtype, device=device)
     Mz, Ms = table.fine_zenith, table.fine_sky
     N = Mz + Ms
     es = 2.0 * _EXT / (Ms - 1 - 2 * _EXT)
     y_z = torch.linspace(-1.0 - ez, 1.0 + ez, Mz, dtype=torch.float64, device=device)
-    per_table = brightness and N * (1 if iso else table.fine_azimuth) < H * W  # kelvin per table row
     if scene.path is not None:
         _check_path_altitude(scene.path, altitude)
 
@@ -758,13 +760,17 @@ def _render_table(
             sky_rows = _sky_rows(_scene_rows(p, sl), scene, s_rows, altitude[sl]).to(dtype)
         else:  # no sky work when no pixel sees sky
             sky_rows = torch.zeros(b_, Ms, dtype=dtype, device=device)
+        if brightness:  # in kelvin at the azimuth nodes, before the azimuth resampling: the
+            # brightness temperature is as smooth in azimuth as the radiance, and this costs
+            # (M_z + M_s) × nphi conversions an image instead of one a pixel
+            sea_rows = _kelvin(sea_rows, scene.band)
+            if has_sky:
+                sky_rows = _kelvin(sky_rows, scene.band)
         if iso:
             fine = torch.cat([sea_rows, sky_rows[:, :, None]], 1)  # (b, N, 1)
         else:  # sea rows resampled in azimuth; sky rows repeated (not through L_o, whose overhang
             # rows sum to 1 only to rounding: sky pixels may read the border columns)
             fine = torch.cat([sea_rows @ Lp_t.T, sky_rows[:, :, None].expand(-1, -1, Lp_t.shape[0])], 1)
-        if per_table:
-            fine = brightness_temperature(fine.clamp_min(torch.finfo(dtype).tiny), scene.band)
 
         # ---- per pixel: the table coordinates, one grid_sample
         k_sea = (2.0 / (N - 1)) * (Mz - 1) / (span_z * (1.0 + ez))  # dgy/dζ
@@ -799,12 +805,21 @@ def _render_table(
         # only to first order; bilinear on the fine table is second order (~1e-7 at 4096 rows).
         vals = F.grid_sample(fine[:, None], torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border",
                              align_corners=True)[:, 0]
-        if brightness and not per_table:
-            vals = brightness_temperature(vals.clamp_min(torch.finfo(dtype).tiny), scene.band)
         return vals
 
     parts = map_chunks(one, [slice(i, min(i + chunk, B)) for i in range(0, B, chunk)], device)
     return parts[0] if len(parts) == 1 else torch.cat(parts)
+
+
+def _kelvin(radiance: torch.Tensor, band: SpectralBand) -> torch.Tensor:
+    """Brightness temperature [K] of band radiances that must be > 0 (``ValueError`` otherwise:
+    without shadowing, Eq. 7 makes R_a negative near the horizon, which has no temperature)."""
+    low = radiance.detach().amin()
+    if not bool(low > 0):
+        raise ValueError(f"output='brightness_temperature': a radiance of {float(low):.3g} W m-2 sr-1 (<= 0) has no "
+                         "brightness temperature; without shadowing (Eq. 7) R_a goes negative near the horizon: "
+                         "use shadowing=True or output='radiance'")
+    return brightness_temperature(radiance, band)
 
 
 def _scene_rows(p: dict[str, Any], sl: slice) -> dict[str, Any]:

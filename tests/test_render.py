@@ -396,3 +396,15 @@ def test_no_warm_line_at_the_horizon(altitude):
     assert abs(float(bt[k - 1]) - dip_bt) < 0.02  # the sky row just above the horizon
     assert float(bt[k]) < float(bt[k - 1]) + 0.05  # no warm line below it
     assert float(bt[:k].max()) < dip_bt + 0.05  # nor anywhere in the sky near the horizon
+
+
+@pytest.mark.parametrize("method", ["table", "direct"])
+def test_kelvin_of_a_negative_radiance_is_an_error(method):
+    """Without shadowing (Eq. 7) R_a goes negative near the horizon; such a pixel has no brightness
+    temperature. It was clamped to a tiny radiance and came out near 13 K; now a ValueError says
+    why. The radiance output is left as the model gives it."""
+    cams = rs.make_camera(16, 16, hfov_deg=10.0, altitude_m=20.0, pitch_deg=-0.3)
+    scene = rs.SeaScene(wind_speed=10.0, sea_temperature=290.0, sky=5.0, shadowing=False, path=False)
+    assert float(rs.render(cams, scene, method=method).min()) < 0.0
+    with pytest.raises(ValueError, match="no brightness temperature.*shadowing=True"):
+        rs.render(cams, scene, method=method, output="brightness_temperature")
