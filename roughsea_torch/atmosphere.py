@@ -332,6 +332,24 @@ def load_sky(
 # --------------------------------------------------------------------------------------------------
 
 
+def _query(a: tuple[str, Any], b: tuple[str, Any], dtype: torch.dtype, device: Any
+           ) -> tuple[torch.Tensor, torch.Tensor, torch.dtype, Any]:
+    """Two query arguments (name, value) as tensors of one float dtype (promoted from tensor
+    arguments, else ``dtype``) and one device (the tensors', else ``device``)."""
+    tensors = [x for _, x in (a, b) if isinstance(x, torch.Tensor)]
+    floats = [x.dtype for x in tensors if x.is_floating_point()]
+    dt = floats[0] if floats else dtype
+    for d in floats[1:]:
+        dt = torch.promote_types(dt, d)
+    if dt not in (torch.float32, torch.float64):
+        raise ValueError(f"{a[0]}, {b[0]}: unsupported dtype {dt}; use torch.float32 or torch.float64")
+    devices = {x.device for x in tensors}
+    if len(devices) > 1:
+        raise ValueError(f"{a[0]} and {b[0]} are on different devices: {sorted(map(str, devices))}")
+    dev = devices.pop() if devices else device
+    return torch.as_tensor(a[1], dtype=dt, device=dev), torch.as_tensor(b[1], dtype=dt, device=dev), dt, dev
+
+
 class AtmosphericPath:
     """Band transmittance and path radiance between a sensor at altitude h and the sea at range r.
 
@@ -413,19 +431,7 @@ class AtmosphericPath:
         return x0, x1
 
     def __call__(self, altitude_m: Any, range_m: Any, *, clamp: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
-        tensors = [x for x in (altitude_m, range_m) if isinstance(x, torch.Tensor)]
-        floats = [x.dtype for x in tensors if x.is_floating_point()]
-        dtype = floats[0] if floats else self.dtype
-        for d in floats[1:]:
-            dtype = torch.promote_types(dtype, d)
-        if dtype not in (torch.float32, torch.float64):
-            raise ValueError(f"altitude_m, range_m: unsupported dtype {dtype}; use torch.float32 or torch.float64")
-        devices = {x.device for x in tensors}
-        if len(devices) > 1:
-            raise ValueError(f"altitude_m and range_m are on different devices: {sorted(map(str, devices))}")
-        device = devices.pop() if devices else self.device
-        h = torch.as_tensor(altitude_m, dtype=dtype, device=device)
-        r = torch.as_tensor(range_m, dtype=dtype, device=device)
+        h, r, dtype, device = _query(("altitude_m", altitude_m), ("range_m", range_m), self.dtype, self.device)
         h, r = torch.broadcast_tensors(h, r)
         shape = h.shape
         h, r = h.reshape(-1), r.reshape(-1)
@@ -806,19 +812,7 @@ class ObserverSky:
     # -- call -------------------------------------------------------------------------------------
 
     def __call__(self, altitude_m: Any, cos_zenith: Any, *, clamp: bool = False) -> torch.Tensor:
-        tensors = [x for x in (altitude_m, cos_zenith) if isinstance(x, torch.Tensor)]
-        floats = [x.dtype for x in tensors if x.is_floating_point()]
-        dtype = floats[0] if floats else self.dtype
-        for d in floats[1:]:
-            dtype = torch.promote_types(dtype, d)
-        if dtype not in (torch.float32, torch.float64):
-            raise ValueError(f"altitude_m, cos_zenith: unsupported dtype {dtype}; use torch.float32 or torch.float64")
-        devices = {x.device for x in tensors}
-        if len(devices) > 1:
-            raise ValueError(f"altitude_m and cos_zenith are on different devices: {sorted(map(str, devices))}")
-        device = devices.pop() if devices else self.device
-        h = torch.as_tensor(altitude_m, dtype=dtype, device=device)
-        c = torch.as_tensor(cos_zenith, dtype=dtype, device=device)
+        h, c, dtype, device = _query(("altitude_m", altitude_m), ("cos_zenith", cos_zenith), self.dtype, self.device)
         lo, hi = self.altitude_range_m
         slack = 1e-6 if dtype == torch.float64 else 1e-5
         if not clamp:
