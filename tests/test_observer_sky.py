@@ -210,3 +210,20 @@ def test_out_of_range_raises_or_clamps():
     assert torch.allclose(sky(torch.tensor(9000.0, dtype=F64), 0.5, clamp=True), sky(5000.0, 0.5))
     with pytest.raises(ValueError, match="name"):
         atm.load_observer_sky("venus")
+
+
+def test_dip_below_the_path_tables_lies_between_sea_level_and_2_m():
+    """Below the path tables' 2 m the horizon ray from h crosses less surface air than from 2 m and
+    more than from the sea surface: the sky at the dip lies between sky₀(90°) and its 2 m value."""
+    sky = atm.load_observer_sky("midlatitude_summer", (8e-6, 12e-6), dtype=torch.float64)
+    sky0 = float(atm.load_sky("midlatitude_summer", (8e-6, 12e-6), dtype=torch.float64)(torch.tensor(0.0)))
+
+    def dip(h):
+        R = atm.EARTH_RADIUS_M
+        return float(sky(torch.tensor(h, dtype=torch.float64),
+                         torch.tensor(-math.sqrt(h * (2 * R + h)) / (R + h), dtype=torch.float64)))
+
+    top = dip(2.0)
+    assert top > sky0  # 2 m of horizon path is warmer than the sea-level horizon sky (LWIR summer)
+    for h in (0.5, 1.0, 1.5):
+        assert sky0 <= dip(h) <= top
