@@ -588,10 +588,7 @@ def write_all(args: argparse.Namespace, argv: list[str] | None, t0: float) -> in
             **checks,
         }
         path = args.out / f"observer_{name}.npz"
-        with np.load(path, allow_pickle=False) as z:
-            tables = {k: z[k] for k in z.files}
-        tables["provenance"] = np.array(json.dumps(prov))
-        np.savez_compressed(path, **tables)
+        lt.write_provenance(path, prov)
         all_prov[name] = prov
         print(f"{name}: {path.stat().st_size / 1e6:.2f} MB, ranks {prov['compression']['rank_upward']}/"
               f"{prov['compression']['rank_below']}")

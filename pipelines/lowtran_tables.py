@@ -1000,6 +1000,14 @@ def _wrapper_crosscheck() -> float:  # runs in a forked child
     return worst
 
 
+def write_provenance(path: Path, prov: dict) -> None:
+    """Rewrite the table file ``path`` (.npz) with ``prov`` as its provenance."""
+    with np.load(path, allow_pickle=False) as z:
+        tables = {k: z[k] for k in z.files}
+    tables["provenance"] = np.array(json.dumps(prov))
+    np.savez_compressed(path, **tables)
+
+
 def summary_lines(name: str, out: Path) -> list[str]:
     import torch
 
@@ -1063,10 +1071,7 @@ def main(argv: list[str] | None = None) -> int:
         }
         # rewrite the table with its check results in the provenance
         path = args.out / f"{name}.npz"
-        with np.load(path, allow_pickle=False) as z:
-            tables = {k: z[k] for k in z.files}
-        tables["provenance"] = np.array(json.dumps(prov))
-        np.savez_compressed(path, **tables)
+        write_provenance(path, prov)
         all_prov[name] = prov
         print(f"{name}: T_surface {prov['surface_air_temperature_K']:.2f} K, {path.stat().st_size / 1e6:.2f} MB, "
               f"path ranks {prov['path_compression']['rank_transmittance']}/{prov['path_compression']['rank_radiance']}")

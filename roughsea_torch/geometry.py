@@ -186,6 +186,12 @@ def view_geometry(
     return out
 
 
+def _component(a: torch.Tensor, x: torch.Tensor, y: torch.Tensor, inv: torch.Tensor) -> torch.Tensor:
+    """a · (x, y, 1) / |(x, y, 1)|: a world axis ``a`` (b, 3, ...) in camera axes against the unit ray
+    of normalized image coordinates (x, y) (``inv`` = 1/|(x, y, 1)|), broadcast over (x, y)."""
+    return ((a[:, 0] * x + a[:, 2]) + a[:, 1] * y) * inv
+
+
 class CameraGeometry:
     """Per-camera constants of the sea intersection, and the per-pixel geometry of any chunk of
     cameras (``pixels(slice)``), so that a renderer can stream images without holding the batch.
@@ -248,8 +254,7 @@ class CameraGeometry:
             inv = torch.rsqrt(x * x + (y * y + 1.0))  # one full-size add
 
             def comp(i: int) -> torch.Tensor:
-                a = A[:, i]
-                return ((a[:, 0, None, None] * x + a[:, 2, None, None]) + a[:, 1, None, None] * y) * inv
+                return _component(A[:, i, :, None, None], x, y, inv)
         else:
             rays = unproject_meshgrid(H, W, K, normalize_points=True, device=self.device, dtype=self.dtype)
 
@@ -283,12 +288,8 @@ class CameraGeometry:
         xy = normalize_points_with_intrinsics(uv.to(self.dtype).expand(K.shape[0], -1, 2), K)
         x, y = xy[..., 0], xy[..., 1]
         inv = torch.rsqrt(x * x + y * y + 1.0)
-        A = self.axes_cam[sl]
-
-        def comp(i: int) -> torch.Tensor:
-            return (A[:, i, 0, None] * x + A[:, i, 1, None] * y + A[:, i, 2, None]) * inv
-
-        return comp(2), comp(0), comp(1)
+        A = self.axes_cam[sl, :, :, None]
+        return tuple(_component(A[:, i], x, y, inv) for i in (2, 0, 1))
 
     def border(self, sl: slice = slice(None)) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """Ray components (dz, dx, dy), each (b, 2(H + W) − 4), of the pixels on the image's border,

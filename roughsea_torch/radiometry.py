@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from ._lookup import bucket_grid, next_nodes
 from ._validation import as_tensor, check_finite_range, resolve_dtype_device
 
 __all__ = [
@@ -152,7 +153,7 @@ def _band_key(band: SpectralBand) -> tuple[tuple, Any]:
     return head + ("table", digest.hexdigest()), None
 
 
-def _cache_get(cache: OrderedDict, key: tuple, guard: Any, resp: Any) -> Any:
+def _cache_get(cache: OrderedDict, key: tuple, resp: Any) -> Any:
     hit = cache.get(key)
     if hit is None:
         return None
@@ -175,7 +176,7 @@ def _cache_put(cache: OrderedDict, key: tuple, guard: Any, value: Any) -> None:
 
 def _band_quadrature(band: SpectralBand) -> tuple[np.ndarray, np.ndarray]:
     key, guard = _band_key(band)
-    hit = _cache_get(_band_cache, key, guard, band.response)
+    hit = _cache_get(_band_cache, key, band.response)
     if hit is not None:
         return hit
     edges = [band.lo, band.hi]
@@ -315,7 +316,7 @@ def _bt_table(band: SpectralBand, dtype: torch.dtype, device: torch.device) -> t
     """
     key, guard = _band_key(band)
     full = key + (dtype, str(device))
-    hit = _cache_get(_bt_cache, full, guard, band.response)
+    hit = _cache_get(_bt_cache, full, band.response)
     if hit is None:
         lam, w = (torch.as_tensor(a, dtype=torch.float64) for a in band.quadrature)
         T = torch.arange(_T_LO, _T_HI + _T_STEP / 2, _T_STEP, dtype=torch.float64)
@@ -328,13 +329,9 @@ def _bt_table(band: SpectralBand, dtype: torch.dtype, device: torch.device) -> t
         c3 = -2.0 * dT + h * (m[:-1] + m[1:])
         inv_h = 1.0 / h
         d1, d2, d3 = c1 * inv_h, c2 * inv_h**2, c3 * inv_h**3
-        y = torch.log(L)
-        width = float((y[1:] - y[:-1]).min()) * (1.0 - 1e-6)
-        nb = int(math.ceil(float(y[-1] - y[0]) / width)) + 1
-        edges = y[0] + width * torch.arange(nb, dtype=torch.float64)
-        start = (torch.searchsorted(y, edges, right=True) - 1).clamp(0, L.numel() - 2)
-        nxt = torch.where(start + 1 <= L.numel() - 2, L[(start + 1).clamp_max(L.numel() - 1)], math.inf)
-        hit = tuple(t.to(device=device, dtype=dtype) for t in (L, T[:-1], d1, d2, d3, torch.tensor([float(y[0]), 1.0 / width]), nxt))
+        y0, inv_w, start = bucket_grid(torch.log(L))
+        nxt = next_nodes(L, start)
+        hit = tuple(t.to(device=device, dtype=dtype) for t in (L, T[:-1], d1, d2, d3, torch.tensor([y0, inv_w]), nxt))
         hit = hit[:6] + (start.to(device=device), hit[6])
         _cache_put(_bt_cache, full, guard, hit)
     return hit

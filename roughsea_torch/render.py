@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import torch
@@ -501,18 +501,17 @@ def _slant_range(cos_t: torch.Tensor, altitude: torch.Tensor, earth_radius_m: fl
 
 
 def _check_path_altitude(path: Any, altitude: torch.Tensor) -> None:
-    if getattr(path, "altitude_range_m", None) is None:  # a user's own path model
-        return
-    lo, hi = path.altitude_range_m
+    """The path model's own check of the camera altitudes (a ray straight down, range = altitude,
+    is valid at any altitude the tables cover), with the way out named."""
     h = altitude.detach()
-    bad = ~((h >= lo * (1 - 1e-5)) & (h <= hi * (1 + 1e-5)))
-    if bool(bad.any()):
-        raise ValueError(f"altitude_m must lie in [{lo:g}, {hi:g}] m, the range of the atmospheric path tables, "
-                         f"when the scene's path is on; got {h[bad][0].item():g} m (SeaScene(path=False) renders "
-                         "without the air between sea and sensor)")
+    try:
+        path(h, h, clamp=False)
+    except ValueError as e:
+        raise ValueError(f"{e}; SeaScene(path=False) renders without the air between sea and sensor") from None
 
 
-def _sky_rows(p: dict[str, Any], scene: SeaScene, cos_z: torch.Tensor, altitude: torch.Tensor) -> torch.Tensor:
+def _sky_rows(sky: Any, air_scale: torch.Tensor | None, scene: SeaScene, cos_z: torch.Tensor,
+              altitude: torch.Tensor) -> torch.Tensor:
     """Sky radiance seen by each camera along rays of zenith cosine ``cos_z`` (B, N) at the camera
     (down to the depressed horizon): from the camera's altitude for a named atmosphere, else the
     scene's sky (rays below the horizontal see its horizon); scaled by the air temperature."""
@@ -520,9 +519,9 @@ def _sky_rows(p: dict[str, Any], scene: SeaScene, cos_z: torch.Tensor, altitude:
     if scene.observer_sky is not None:
         rad = scene.observer_sky(altitude.to(cos_z.dtype)[:, None], cos_z, clamp=True)
     else:
-        rad = _sky_radiance_pixels(_sky_per_image(p["sky"], B, cos_z.dtype, cos_z.device, 0), cos_z)
-    if p["air_scale"] is not None:
-        rad = rad * p["air_scale"][:, None].to(rad.dtype)
+        rad = _sky_radiance_pixels(_sky_per_image(sky, B, cos_z.dtype, cos_z.device, 0), cos_z)
+    if air_scale is not None:
+        rad = rad * air_scale[:, None].to(rad.dtype)
     return rad
 
 
@@ -583,7 +582,7 @@ def render(
                 _check_path_altitude(scene.path, altitude)
                 img = _apply_path(scene.path, img, altitude, geom.range_m, sea, p["air_scale"])
         if bool((~sea).any()):
-            sky_pix = _sky_rows(p, scene, geom.cos_view_zenith.reshape(B, -1), altitude).reshape(B, H, W)
+            sky_pix = _sky_rows(p["sky"], p["air_scale"], scene, geom.cos_view_zenith.reshape(B, -1), altitude).reshape(B, H, W)
             img = sky_pix if img is None else torch.where(sea, img, sky_pix)
         img = img.reshape(B, 1, H, W)
         if output == "brightness_temperature":
@@ -757,7 +756,8 @@ def _render_table(
         has_sky = bool(rg.any_sky.any())
         if has_sky:
             s_rows = (s0[:, None] + ds[:, None] * torch.arange(Ms, dtype=torch.float64, device=device)).to(dtype)
-            sky_rows = _sky_rows(_scene_rows(p, sl), scene, s_rows, altitude[sl]).to(dtype)
+            air = None if p["air_scale"] is None else p["air_scale"][sl]
+            sky_rows = _sky_rows(select_sky(p["sky"], sl), air, scene, s_rows, altitude[sl]).to(dtype)
         else:  # no sky work when no pixel sees sky
             sky_rows = torch.zeros(b_, Ms, dtype=dtype, device=device)
         if brightness:  # in kelvin at the azimuth nodes, before the azimuth resampling: the
@@ -820,11 +820,6 @@ def _kelvin(radiance: torch.Tensor, band: SpectralBand) -> torch.Tensor:
                          "brightness temperature; without shadowing (Eq. 7) R_a goes negative near the horizon: "
                          "use shadowing=True or output='radiance'")
     return brightness_temperature(radiance, band)
-
-
-def _scene_rows(p: dict[str, Any], sl: slice) -> dict[str, Any]:
-    """The resolved scene ``p`` of images ``sl`` as far as :func:`_sky_rows` needs it."""
-    return dict(sky=select_sky(p["sky"], sl), air_scale=None if p["air_scale"] is None else p["air_scale"][sl])
 
 
 class SeaRenderer(torch.nn.Module):

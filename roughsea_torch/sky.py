@@ -17,6 +17,8 @@ from typing import Any, Callable
 import numpy as np
 import torch
 
+from ._lookup import bucket_grid, next_nodes
+
 __all__ = ["TabulatedSky", "ConstantSky", "as_sky", "select_sky", "pchip_derivatives"]
 
 
@@ -96,22 +98,18 @@ class TabulatedSky:
         """Per (dtype, device): the nodes z, radiance r, PCHIP slopes d, and for the lookup a
         uniform bucket grid over [z₀, z_end] (origin, 1/width) whose width is the smallest node
         spacing, so a bucket meets at most two intervals, with per bucket its first interval and
-        where the next one starts (M, 2); for a single table also per interval (N−1, 6) its start,
+        where the next one starts (M, 2) (:mod:`roughsea_torch._lookup`); for a single table also per interval (N−1, 6) its start,
         1/width and the power-form coefficients of the cubic in t ∈ [0, 1] (one gather a query)."""
         key = (dtype, device)
         if self.radiance.requires_grad or key not in self._cache:
             z64 = self.zenith.detach().double().cpu()
-            h64 = z64[1:] - z64[:-1]
-            width = float(h64.min())
-            m = int(math.ceil(float(z64[-1] - z64[0]) / width)) + 1
-            edges = z64[0] + width * torch.arange(m, dtype=torch.float64)
-            start = (torch.searchsorted(z64, edges, right=True) - 1).clamp(0, z64.numel() - 2)
-            split = z64[(start + 1).clamp(max=z64.numel() - 1)]  # a query at or past it is in the next interval
+            z_0, inv_width, start = bucket_grid(z64)
+            split = next_nodes(z64, start)  # a query at or past it is in the next interval
             z = self.zenith.to(dtype=dtype, device=device)
             r = self.radiance.to(dtype=dtype, device=device)
             d = pchip_derivatives(z, r)
-            bucket = (torch.tensor(float(z64[0]), dtype=dtype, device=device),
-                      torch.tensor(1.0 / width, dtype=dtype, device=device),
+            bucket = (torch.tensor(z_0, dtype=dtype, device=device),
+                      torch.tensor(inv_width, dtype=dtype, device=device),
                       torch.stack([start.to(dtype), split.to(dtype)], -1).to(device))
             coef = None
             if r.ndim == 1:  # y(t) = y0 + t (h d0 + t (3Δ − h(2 d0 + d1) + t (−2Δ + h(d0 + d1))))
