@@ -161,12 +161,17 @@ class _Geom:
     su: torch.Tensor  # σ∥, rms slope along the view azimuth
     kappa: torch.Tensor  # regression of s⊥ on s∥
     tau: torch.Tensor  # conditional rms of s⊥ given s∥
+    mu: torch.Tensor  # mean of s∥ (0 unless the statistics are shifted)
+    mv: torch.Tensor  # mean of s⊥
+
+    def _fields(self) -> tuple[torch.Tensor, ...]:
+        return (self.ct, self.st, self.su, self.kappa, self.tau, self.mu, self.mv)
 
     def flat(self, shape: torch.Size) -> _Geom:
-        return _Geom(*(t.expand(shape).reshape(-1) for t in (self.ct, self.st, self.su, self.kappa, self.tau)))
+        return _Geom(*(t.expand(shape).reshape(-1) for t in self._fields()))
 
     def take(self, idx: torch.Tensor | slice) -> _Geom:
-        return _Geom(self.ct[idx], self.st[idx], self.su[idx], self.kappa[idx], self.tau[idx])
+        return _Geom(*(t[idx] for t in self._fields()))
 
 
 def _floors(dtype: torch.dtype) -> tuple[float, float]:
@@ -180,7 +185,8 @@ def _floors(dtype: torch.dtype) -> tuple[float, float]:
     return 1e-12, 1e-12
 
 
-def _geometry(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor) -> _Geom:
+def _geometry(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor,
+              mx: torch.Tensor | None = None, my: torch.Tensor | None = None) -> _Geom:
     cmin, smin = _floors(vz.dtype)
     ct = torch.cos(vz).clamp_min(cmin)
     st = torch.sin(vz).clamp(0.0, 1.0)
@@ -194,18 +200,26 @@ def _geometry(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Te
     kappa = torch.where(ok, cuv / su2s, torch.zeros_like(su2))
     tau2 = torch.where(ok, det / su2s, sv2)
     tau = torch.sqrt(tau2.clamp_min(smin * smin))
-    return _Geom(ct, st, torch.sqrt(su2s), kappa, tau)
+    if mx is None:
+        mu = mv = torch.zeros_like(su2)
+    else:  # the mean slope in the view frame (s∥, s⊥)
+        mu, mv = mx * c + my * s, my * c - mx * s
+    return _Geom(ct, st, torch.sqrt(su2s), kappa, tau, mu, mv)
 
 
 def _denominator(g: _Geom, shadowing: bool) -> torch.Tensor:
-    """D of Eq. 5 (shadowing) or Eq. 7 (cos θ̂), closed form (physics.md §3)."""
+    """D of Eq. 5 (shadowing) or Eq. 7 (cos θ̂), closed form (physics.md §3).
+
+    With a mean slope m∥ along the view, t = cos θ̂ + sin θ̂ s∥ has mean e = cos θ̂ + sin θ̂ m∥ and
+    D = E[t H(t)] = e Φ(e/a) + a φ(e/a), a = sin θ̂ σ∥ (Eq. 7: D = e)."""
+    e = g.ct + g.st * g.mu
     if not shadowing:
-        return g.ct
+        return e
     a = g.st * g.su
-    big = g.ct > 40.0 * a  # μ > 40: Φ(μ) = 1, φ(μ) = 0 to every precision
-    mu = g.ct / torch.where(big, torch.ones_like(a), a)
+    big = e > 40.0 * a  # μ > 40: Φ(μ) = 1, φ(μ) = 0 to every precision
+    mu = e / torch.where(big, torch.ones_like(a), a)
     mu = torch.where(big, torch.full_like(mu, 40.0), mu)
-    return torch.where(big, g.ct, g.ct * _Phi(mu) + a * _phi(mu))
+    return torch.where(big, e, e * _Phi(mu) + a * _phi(mu))
 
 
 # -- the two integrals -----------------------------------------------------------------------
@@ -220,9 +234,10 @@ def _emissivity_numerator(
     zh, wh = _nodes("gh", q.hermite, dtype, device)
     K = float(q.width)
     a = g.st * g.su
-    big = g.ct > K * a
-    xs = -g.ct / torch.where(big, torch.ones_like(a), a)
-    xs = torch.where(big, torch.full_like(xs, -K), xs.clamp(-K, K))  # shadow edge in u/σ∥
+    e = g.ct + g.st * g.mu  # the mean of t
+    big = e > K * a
+    xs = -e / torch.where(big, torch.ones_like(a), a)
+    xs = torch.where(big, torch.full_like(xs, -K), xs.clamp(-K, K))  # shadow edge in (u − m∥)/σ∥
     panels = [(xs, torch.full_like(xs, K))]
     if not shadowing:
         panels.append((torch.full_like(xs, -K), xs))
@@ -232,9 +247,10 @@ def _emissivity_numerator(
         half = 0.5 * (hi - lo)
         x = (0.5 * (hi + lo))[:, None] + half[:, None] * xg  # (m, no)
         W = half[:, None] * wg * _phi(x)
-        u = g.su[:, None] * x
+        du = g.su[:, None] * x
+        u = g.mu[:, None] + du
         t = g.ct[:, None] + g.st[:, None] * u
-        v = (g.kappa[:, None] * u)[..., None] + g.tau[:, None, None] * zh  # (m, no, nh)
+        v = (g.mv[:, None] + g.kappa[:, None] * du)[..., None] + g.tau[:, None, None] * zh  # (m, no, nh)
         cos_o = t.abs()[..., None] * torch.rsqrt(1.0 + u[..., None] ** 2 + v * v)
         _, _, es, ep = _fresnel_terms(cos_o.clamp_max(1.0), n_, k_)
         e = (0.5 * (es + ep) * wh).sum(-1)
@@ -270,24 +286,31 @@ def _sky_numerator(
         return _asin2(d / (A * sqrt_1mB2 + B * C))
 
     u_far = (1.0 + st) / ct
-    u_lo = torch.maximum(-alpha, -K * su)
-    u_hi = torch.minimum(u_far, K * su)
+    mu, mv = g.mu, g.mv
+    u_lo = torch.maximum(-alpha, mu - K * su)
+    u_hi = torch.minimum(u_far, mu + K * su)
     # At the disc's own edges the angle is exact (ψ = 0, π): shift() would take the square root of
     # a rounding-level number there, and jitter every node by ~√ε.
-    d_lo = torch.where(-alpha >= -K * su, -psi0, shift(u_lo))
-    d_hi = torch.where(u_far <= K * su, math.pi - psi0, shift(u_hi))
+    d_lo = torch.where(-alpha >= mu - K * su, -psi0, shift(u_lo))
+    d_hi = torch.where(u_far <= mu + K * su, math.pi - psi0, shift(u_hi))
+    d_hi = torch.maximum(d_hi, d_lo)  # a shifted window may miss the disc: an empty panel
     # Where the ridge s⊥ = κ s∥ of the Gaussian leaves the disc, the chord edge sweeps through the
     # inner Gaussian and the outer integrand steps within ~τ/|κ|: split the outer panel there.
-    # The exits solve (1 + κ²) u² − 2 u tan θ̂ − 1 = 0 (both roots real, one on each side of 0).
+    # The exits of the ridge s⊥ = κ s∥ + d (d = m⊥ − κ m∥) solve (1 + κ²) u² − 2 (tan θ̂ − κ d) u
+    # + d² − 1 = 0 (zero mean: both roots real, one on each side of 0; a shifted ridge that misses
+    # the disc gives its tangent point, where splitting is harmless).
     # Only a thin ridge (τ < split·|κ|·σ∥, e.g. a/b ≫ 1 or |r| → 1) needs it; Cox–Munk anisotropy
     # (a/b ≤ 1.3, r = 0) does not, and keeps a single panel (a third of the work). The decision is
     # made per sea state by the caller, so results do not depend on batching or chunking.
     if split:
         kap2 = 1.0 + g.kappa * g.kappa
-        tan_t = st / ct
-        root = torch.sqrt(tan_t * tan_t + kap2)
-        u_minus = -1.0 / (tan_t + root)  # = (tan θ̂ − root)/(1 + κ²), without cancellation
-        u_plus = (tan_t + root) / kap2
+        dd = mv - g.kappa * mu
+        bq = st / ct - g.kappa * dd
+        root = torch.sqrt((bq * bq - kap2 * (dd * dd - 1.0)).clamp_min(0.0))
+        qq = bq + torch.where(bq >= 0, root, -root)  # the larger-magnitude root times (1 + κ²)
+        qq = torch.where(qq.abs() > tiny, qq, torch.full_like(qq, tiny))
+        r1, r2 = qq / kap2, (dd * dd - 1.0) / qq  # the product of the roots is (d² − 1)/(1 + κ²)
+        u_minus, u_plus = torch.minimum(r1, r2), torch.maximum(r1, r2)
         d_m = torch.minimum(torch.maximum(shift(u_minus), d_lo), d_hi)
         d_p = torch.minimum(torch.maximum(shift(u_plus), d_m), d_hi)
         panels = [(d_lo, d_m), (d_m, d_p), (d_p, d_hi)]
@@ -301,10 +324,10 @@ def _sky_numerator(
     inv_ct = (1.0 / ct)[:, None]
     u = 2.0 * inv_ct * torch.sin(psi0[:, None] + 0.5 * delta) * torch.sin(0.5 * delta)
     h = (inv_ct * torch.sin(psi0[:, None] + delta)).clamp_min(0.0)  # half-chord = du/dψ
-    x = u / su[:, None]
+    x = (u - mu[:, None]) / su[:, None]
     W = wdelta * h * _phi(x) / su[:, None]
     t = ct[:, None] + st[:, None] * u
-    c = g.kappa[:, None] * u
+    c = mv[:, None] + g.kappa[:, None] * (u - mu[:, None])
     tau = g.tau[:, None]
     z_lo = ((-h - c) / tau).clamp(-K, K)
     z_hi = ((h - c) / tau).clamp(-K, K)
@@ -427,7 +450,11 @@ def _prepare(view_zenith, view_azimuth, slopes, refractive_index=None, **extra):
     vz = as_tensor(view_zenith, dtype, device)
     va = as_tensor(view_azimuth, dtype, device)
     vx, vy, cxy = slopes.tensors(dtype, device)
-    return dtype, device, vz, va, vx, vy, cxy
+    if slopes.has_mean:
+        mx, my = slopes.mean_tensors(dtype, device)
+        vx, vy, cxy = (t + 0 * (mx + my) for t in (vx, vy, cxy))  # the mean's batch shape joins
+        return dtype, device, vz, va, vx, vy, cxy, mx, my
+    return dtype, device, vz, va, vx, vy, cxy, None, None
 
 
 # -- public functions ------------------------------------------------------------------------
@@ -446,15 +473,15 @@ def projected_area(view_zenith: Any, view_azimuth: Any, slopes: SlopeStatistics,
         D [dimensionless]: cos θ̂ Φ(μ) + sin θ̂ σ∥ φ(μ) with μ = cot θ̂/σ∥ (= cos θ̂ (1 + Λ), Smith's
         shadowing function Λ), or cos θ̂ without shadowing (Eq. 7).
     """
-    _, _, vz, va, vx, vy, cxy = _prepare(view_zenith, view_azimuth, slopes)
-    return _denominator(_geometry(vz, va, vx, vy, cxy), shadowing)
+    _, _, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes)
+    return _denominator(_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
 
 
 def smith_lambda(view_zenith: Any, view_azimuth: Any, slopes: SlopeStatistics) -> torch.Tensor:
     """Smith's (1967) Λ = D / cos θ̂ − 1: the fraction of LOS-projected area added by facets that
     face the sensor beyond the horizontal projection [dimensionless]. Diverges as θ̂ → 90°."""
-    _, _, vz, va, vx, vy, cxy = _prepare(view_zenith, view_azimuth, slopes)
-    g = _geometry(vz, va, vx, vy, cxy)
+    _, _, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes)
+    g = _geometry(vz, va, vx, vy, cxy, mx, my)
     return _denominator(g, True) / g.ct - 1.0
 
 
@@ -485,13 +512,14 @@ def emissivity(
         >>> round(float(emissivity(0.0, 0.0, s, 1.218 + 0.0508j)), 4)
         0.9898
     """
-    dtype, device, vz, va, vx, vy, cxy = _prepare(view_zenith, view_azimuth, slopes, refractive_index)
+    dtype, device, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes, refractive_index)
     n, k = split_refractive_index(refractive_index, dtype, device)
     q = quadrature or Quadrature.default(dtype)
     shape = torch.broadcast_shapes(vz.shape, va.shape, vx.shape, vy.shape, cxy.shape, n.shape, k.shape)
     work = _work_dtype(dtype, shadowing)
     vz, va, vx, vy, cxy, n, k = (t.to(work) for t in (vz, va, vx, vy, cxy, n, k))
-    g = _geometry(vz, va, vx, vy, cxy).flat(shape)
+    mx, my = (None if t is None else t.to(work) for t in (mx, my))
+    g = _geometry(vz, va, vx, vy, cxy, mx, my).flat(shape)
     D = _denominator(g, shadowing)
     nf, kf = n.expand(shape).reshape(-1), k.expand(shape).reshape(-1)
     points = q.outer * q.hermite * (1 if shadowing else 2)
@@ -598,7 +626,7 @@ def _reflection_terms(
     sky_fn = as_sky(sky)
     sky_tensor = sky_fn.radiance if isinstance(sky_fn, (TabulatedSky, ConstantSky)) else None
     extra = {k: v for k, v in (_extra or {}).items() if isinstance(v, torch.Tensor)}
-    dtype, device, vz, va, vx, vy, cxy = _prepare(view_zenith, view_azimuth, slopes, refractive_index, **extra)
+    dtype, device, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes, refractive_index, **extra)
     if isinstance(sky_tensor, torch.Tensor):  # a sky table follows the call's dtype; only its device must match
         check_same_device(view_zenith=vz, sky=sky_tensor)
     n, k = split_refractive_index(refractive_index, dtype, device)
@@ -608,7 +636,8 @@ def _reflection_terms(
     )
     work = _work_dtype(dtype, shadowing)
     vz, va, vx, vy, cxy, n, k = (t.to(work) for t in (vz, va, vx, vy, cxy, n, k))
-    g = _geometry(vz, va, vx, vy, cxy).flat(shape)
+    mx, my = (None if t is None else t.to(work) for t in (mx, my))
+    g = _geometry(vz, va, vx, vy, cxy, mx, my).flat(shape)
     if g.ct.numel() == 0:
         z = torch.zeros(shape, dtype=work, device=device)
         return z, z, dtype

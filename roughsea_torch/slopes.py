@@ -24,7 +24,7 @@ Number = float | int
 
 
 class SlopeStatistics:
-    """Zero-mean Gaussian slope statistics of the sea surface.
+    """Gaussian slope statistics of the sea surface (zero mean unless :meth:`shifted`).
 
     Args:
         std_upwind: a, rms slope along the upwind axis [dimensionless, ≥ 0]; float or tensor.
@@ -52,6 +52,27 @@ class SlopeStatistics:
         self.var_upwind = var_upwind
         self.var_crosswind = var_crosswind
         self.cov = cov
+        self.mean_upwind: Any = 0.0
+        self.mean_crosswind: Any = 0.0
+
+    def shifted(self, mean_upwind: Any, mean_crosswind: Any = 0.0) -> SlopeStatistics:
+        """The same covariance about a non-zero mean slope μ = (μ_up, μ_cross) [dimensionless].
+
+        The two-scale sea (``docs/waves.md`` §2): under a resolved wave that tilts the surface by
+        μ, the unresolved slopes are N(s; μ, Σ_u) in the world (upwind, crosswind) frame, while the
+        sky stays in the world frame. Every function of the model accepts such statistics (the
+        facet weight of Eq. 5 and its denominator D are taken over the shifted density).
+        """
+        check_finite_range("mean_upwind", mean_upwind)
+        check_finite_range("mean_crosswind", mean_crosswind)
+        obj = SlopeStatistics.__new__(SlopeStatistics)
+        obj._init_variances(self.var_upwind, self.var_crosswind, self.cov)
+        obj.mean_upwind, obj.mean_crosswind = mean_upwind, mean_crosswind
+        return obj
+
+    @property
+    def has_mean(self) -> bool:
+        return any(isinstance(m, torch.Tensor) or m != 0.0 for m in (self.mean_upwind, self.mean_crosswind))
 
     @classmethod
     def from_variances(cls, var_upwind: Any, var_crosswind: Any, cov: Any = 0.0) -> SlopeStatistics:
@@ -118,8 +139,15 @@ class SlopeStatistics:
             as_tensor(self.cov, dtype, device),
         )
 
+    def mean_tensors(self, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, torch.Tensor]:
+        """(μ_up, μ_cross) as tensors of ``dtype`` on ``device`` (zeros for zero-mean statistics)."""
+        return as_tensor(self.mean_upwind, dtype, device), as_tensor(self.mean_crosswind, dtype, device)
+
     def parameters_dict(self) -> dict[str, Any]:
-        return {"var_upwind": self.var_upwind, "var_crosswind": self.var_crosswind, "cov": self.cov}
+        d = {"var_upwind": self.var_upwind, "var_crosswind": self.var_crosswind, "cov": self.cov}
+        if self.has_mean:
+            d.update(mean_upwind=self.mean_upwind, mean_crosswind=self.mean_crosswind)
+        return d
 
     def __repr__(self) -> str:
         def fmt(x: Any) -> str:
@@ -129,7 +157,8 @@ class SlopeStatistics:
 
         return (
             f"SlopeStatistics(var_upwind={fmt(self.var_upwind)}, "
-            f"var_crosswind={fmt(self.var_crosswind)}, cov={fmt(self.cov)})"
+            f"var_crosswind={fmt(self.var_crosswind)}, cov={fmt(self.cov)}"
+            + (f", mean=({fmt(self.mean_upwind)}, {fmt(self.mean_crosswind)}))" if self.has_mean else ")")
         )
 
 
@@ -161,15 +190,16 @@ def slope_pdf(theta: Any, phi: Any, slopes: SlopeStatistics) -> torch.Tensor:
         p(θ, φ) = sec²θ tanθ · N(s; 0, Σ) with s = tanθ (cos φ, sin φ): the bivariate normal of the
         slopes times the Jacobian of (s_x, s_y) → (θ, φ). In this form the exponent is
         −½ tan²θ (b² cos²φ + a² sin²φ − 2 r a b cos φ sin φ) / det Σ, which is A8 divided by
-        (1 − r²), i.e. the paper's Eq. A7.
+        (1 − r²), i.e. the paper's Eq. A7. Shifted statistics use N(s; μ, Σ).
     """
     dtype, device = resolve_dtype_device(theta=theta, phi=phi, **slopes.parameters_dict())
     th = as_tensor(theta, dtype, device)
     ph = as_tensor(phi, dtype, device)
     vx, vy, cxy = slopes.tensors(dtype, device)
+    mx, my = slopes.mean_tensors(dtype, device)
     det = vx * vy - cxy * cxy
     tan_t = torch.tan(th)
-    c, s = torch.cos(ph), torch.sin(ph)
-    quad = tan_t**2 * (vy * c * c + vx * s * s - 2.0 * cxy * c * s) / det
+    sx, sy = tan_t * torch.cos(ph) - mx, tan_t * torch.sin(ph) - my  # s − μ
+    quad = (vy * sx * sx + vx * sy * sy - 2.0 * cxy * sx * sy) / det
     jac = tan_t / torch.cos(th) ** 2
     return jac * torch.exp(-0.5 * quad) / (2.0 * math.pi * torch.sqrt(det))
