@@ -211,6 +211,7 @@ class CameraGeometry:
         self.flat = flat = math.isinf(earth_radius_m)
         self.earth_radius_m = float(earth_radius_m)
         centres = -(cameras.rotation_matrix.transpose(-1, -2) @ cameras.translation_vector)[..., 0]
+        self.centres = centres  # world [m], (B, 3), differentiable in the pose
         P = centres.to(torch.float64)
         if not flat:
             P = P + torch.tensor([0.0, 0.0, earth_radius_m], dtype=torch.float64, device=dev)

@@ -38,6 +38,7 @@ from kornia.geometry.camera import PinholeCamera
 from ._parallel import map_chunks
 from ._validation import check_finite_range, per_batch
 from .expectation import Quadrature, _reflection_terms, apparent_radiance
+from .clutter import TextureTable
 from .geometry import EARTH_RADIUS_M, CameraGeometry, ViewGeometry, view_geometry
 from .optics import band_refractive_index, split_refractive_index
 from .radiometry import LWIR, SpectralBand, as_band, band_radiance, brightness_temperature
@@ -84,6 +85,16 @@ class SeaScene:
             is exact where the air is optically thick (the horizon sky, long paths: radiance
             → B(T_air)) and first-order right for thin emission from near-surface air (the LWIR
             window's water vapour); it does not change the transmittance.
+        seed: ``None`` (default): the expectation image, the mean over the sea's slope statistics.
+            An int, or one int per image (sequence or (B,) tensor): a textured sea, that
+            realization of a :class:`~roughsea_torch.waves.WaveField` (Elfouhaily spectrum at
+            ``wind_speed``, so ``wind_speed=`` is needed), rendered two-scale
+            (:mod:`roughsea_torch.clutter`): waves longer than a pixel's footprint are geometry,
+            the rest stays in the expectation with the slope covariance left over. With one int
+            for B > 1 images, image i gets the seed derived from (seed, i); give one seed per
+            image for frames that do not depend on how a batch is split.
+        time_s: time of the realization [s], float or (B,); waves move by their dispersion
+            relation, so one seed at successive times is a coherent clip.
 
     Example:
         >>> scene = SeaScene(wind_speed=torch.tensor([3.0, 12.0]), wind_direction=0.5,
@@ -108,6 +119,8 @@ class SeaScene:
         shadowing: bool = True,
         path: Any = None,
         air_temperature: Any = None,
+        seed: Any = None,
+        time_s: Any = 0.0,
     ):
         if (slopes is None) == (wind_speed is None):
             raise ValueError("SeaScene: give exactly one of slopes= or wind_speed=")
@@ -159,6 +172,19 @@ class SeaScene:
         self.air_temperature = air_temperature
         self.refractive_index = refractive_index
         self.shadowing = shadowing
+        if seed is not None:
+            if wind_speed is None:
+                raise ValueError("seed: a textured sea needs wind_speed= (the wave spectrum is driven by the wind); "
+                                 "seed=None renders the expectation image of slopes=")
+            seeds = seed.tolist() if isinstance(seed, torch.Tensor) else seed
+            seeds = [seeds] if not isinstance(seeds, (list, tuple, np.ndarray)) else list(seeds)
+            if not seeds or not all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v < 2**63 for v in seeds):
+                raise ValueError(f"seed must be None, an int in [0, 2**63) or a sequence of such ints (one per image); got {seed!r}")
+            seed = seeds[0] if (isinstance(seed, int)) else seeds
+        check_finite_range("time_s", time_s, unit="s")
+        self.seed = seed
+        self.time_s = time_s
+        self._wave_fields: dict[Any, Any] = {}
 
     @property
     def observer_sky(self) -> Any:
@@ -182,13 +208,44 @@ class SeaScene:
             int(v.shape[0])
             for v in (
                 self.slopes.var_upwind, self.slopes.var_crosswind, self.slopes.cov, self.wind_direction,
-                self.sea_temperature, self.sea_radiance, self.air_temperature,
+                self.sea_temperature, self.sea_radiance, self.air_temperature, self.time_s,
             )
             if isinstance(v, torch.Tensor) and v.ndim > 0
         }
+        if isinstance(self.seed, list) and len(self.seed) > 1:
+            sizes.add(len(self.seed))
         if len(sizes) > 1:
             raise ValueError(f"SeaScene: fields disagree on the batch size: {sorted(sizes)}")
         return sizes.pop() if sizes else 1
+
+    def seeds(self, B: int) -> list[int]:
+        """One seed per image: the given ones, or for one int ``seed`` with B > 1 images, image i's
+        from numpy's ``SeedSequence((seed, i))``."""
+        if isinstance(self.seed, list):
+            return self.seed * B if len(self.seed) == 1 else list(self.seed)
+        if B == 1:
+            return [int(self.seed)]
+        return [int(np.random.SeedSequence((int(self.seed), i)).generate_state(1, np.uint64)[0] >> 1) for i in range(B)]
+
+    def wave_field(self, B: int, dtype: torch.dtype, device: torch.device, sl: slice = slice(None)) -> Any:
+        """The :class:`~roughsea_torch.waves.WaveField` of images ``sl`` (textured scenes only).
+        The last one is kept while the scene's wind, direction and seed are unchanged (its random
+        amplitudes are drawn once)."""
+        from .waves import WaveField
+
+        wind = per_batch("wind_speed", self.wind_speed, B, dtype, device)[sl]
+        wd = per_batch("wind_direction", self.wind_direction, B, dtype, device)[sl]
+        seeds = self.seeds(B)[sl]
+        key = (tuple(seeds), tuple(wind.detach().cpu().tolist()), tuple(wd.detach().cpu().tolist()), dtype, str(device),
+               wind.requires_grad or wd.requires_grad)
+        wf = self._wave_fields.get(key)
+        if wf is None or key[-1]:
+            wf = WaveField(wind, seeds, wind_direction=wd, dtype=dtype, device=device)
+            if not key[-1]:
+                if len(self._wave_fields) >= 8:
+                    self._wave_fields.pop(next(iter(self._wave_fields)))
+                self._wave_fields[key] = wf
+        return wf
 
     def resolved(self, B: int, dtype: torch.dtype, device: torch.device) -> dict[str, Any]:
         """Per-image tensors (B,): a², b², r a b, wind direction, R_B, n, k; and the sky."""
@@ -280,6 +337,11 @@ class TableSize:
             zenith over the span of the image's sky pixels.
         span: ``"pixels"`` (default): nodes only over the angles the image's sea pixels span;
             ``"full"``: over every angle (θ̂ in [0°, 90°], every azimuth), for comparison.
+        texture: nodes in x = a/σ_a, the flat-point quantile of the resolved along-view slope
+            (textured scenes, :mod:`roughsea_torch.clutter`), Chebyshev–Lobatto over
+            ±``texture_width``; beyond it (|x| > 4.5: 7e-6 of the pixels) the border value.
+        fine_texture, fine_texture_zenith, fine_texture_azimuth: the fine texture volume
+            (x, ζ, azimuth) read by one trilinear ``grid_sample`` per sea pixel.
     """
 
     zenith: int = 21
@@ -291,14 +353,20 @@ class TableSize:
     fine_sky: int = 2048
     zenith_thin: int = 41
     fine_azimuth_thin: int = 128
+    texture: int = 9
+    texture_width: float = 4.5
+    fine_texture: int = 33
+    fine_texture_zenith: int = 512
+    fine_texture_azimuth: int = 16
 
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):
             raise ValueError(f"TableSize.span must be 'pixels' or 'full'; got {self.span!r}")
-        for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin"):
+        for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin", "texture"):
             if int(getattr(self, name)) < 2:
                 raise ValueError(f"TableSize.{name} must be >= 2")
-        for name in ("fine_zenith", "fine_azimuth", "fine_sky", "fine_azimuth_thin"):
+        for name in ("fine_zenith", "fine_azimuth", "fine_sky", "fine_azimuth_thin", "fine_texture",
+                     "fine_texture_zenith", "fine_texture_azimuth"):
             if int(getattr(self, name)) < 4 * _EXT + 2:
                 raise ValueError(f"TableSize.{name} must be >= {4 * _EXT + 2}")
 
@@ -577,7 +645,8 @@ def render(
             p_sea = p
             if p["air_scale"] is not None:  # one scaled sky table per image
                 p_sea = dict(p, sky=p["sky"].with_radiance(p["sky"].radiance.to(dtype=dtype, device=device) * p["air_scale"][:, None]))
-            img = _sea_direct(geom, p_sea, scene, q)
+            img = (_sea_direct(geom, p_sea, scene, q) if scene.seed is None
+                   else _sea_direct_textured(geom, cameras, p_sea, scene, q, B, dtype, device))
             if scene.path is not None:
                 _check_path_altitude(scene.path, altitude)
                 img = _apply_path(scene.path, img, altitude, geom.range_m, sea, p["air_scale"])
@@ -613,6 +682,41 @@ def _sea_direct(geom: ViewGeometry, p: dict[str, Any], scene: SeaScene, q: Quadr
         th, ph, slopes, (p["n"][img_idx], p["k"][img_idx]), sea_radiance=p["rb"][img_idx], sky=sky,
         shadowing=scene.shadowing, quadrature=q,
     )
+    out = torch.zeros(sea.shape, dtype=vals.dtype, device=vals.device)
+    return out.index_put((sea,), vals)
+
+
+def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str, Any], scene: SeaScene,
+                         q: Quadrature, B: int, dtype: torch.dtype, device: torch.device) -> torch.Tensor:
+    """The textured sea per pixel (the baseline of the texture volume): each sea pixel's own
+    footprint, resolved slope, visible slope a' and shifted expectation (:mod:`roughsea_torch.clutter`)."""
+    from .clutter import footprint, pixel_resolved_slope, reconcile_scale, unresolved_statistics, visible_slope
+
+    sea = geom.is_sea
+    wf = scene.wave_field(B, dtype, device)
+    total = wf.band_covariance().sum(1)
+    lam = reconcile_scale((total[:, 0], total[:, 1], total[:, 2]), p["vx"], p["vy"], p["cxy"], p["wind_direction"])
+    centres = -(cameras.rotation_matrix.transpose(-1, -2) @ cameras.translation_vector)[..., 0].to(dtype)
+    cos_t = geom.cos_view_zenith.clamp_min(1e-9)
+    R = torch.where(sea, geom.range_m, torch.ones_like(cos_t))
+    L = footprint(R, cos_t, (1.0 / cameras.fx.to(dtype))[:, None, None])
+    dx, dy = geom._dx, geom._dy
+    time = per_batch("time_s", scene.time_s, B, dtype, device)
+    smp = wf.sample(centres[:, 0, None, None] + R * dx, centres[:, 1, None, None] + R * dy, time, footprint=L,
+                    elevation=False)
+    l_ = lam[:, None, None]
+    x, var_a, kap = pixel_resolved_slope(l_ * smp["slope_x"], l_ * smp["slope_y"],
+                                         tuple(c * l_ * l_ for c in wf.resolved_covariance(L)), dx, dy)
+    img_idx = torch.arange(B, device=device)[:, None, None].expand_as(sea)[sea]
+    th, ph = geom.view_zenith[sea], _relative_azimuth(geom, p)[sea]
+    vx, vy, cxy = p["vx"][img_idx], p["vy"][img_idx], p["cxy"][img_idx]
+    c, s_ = torch.cos(ph), torch.sin(ph)
+    va_, kp_ = var_a[sea], kap[sea]
+    sig_u = torch.sqrt((vx * c * c + 2 * cxy * c * s_ + vy * s_ * s_ - va_).clamp_min(1e-30))
+    ap = visible_slope(x[sea][:, None], torch.cos(th), torch.sin(th), torch.sqrt(va_.clamp_min(1e-30)), sig_u)[:, 0]
+    slopes = unresolved_statistics(vx, vy, cxy, ph, va_, kp_, ap)
+    vals = apparent_radiance(th, ph, slopes, (p["n"][img_idx], p["k"][img_idx]), sea_radiance=p["rb"][img_idx],
+                             sky=select_sky(p["sky"], img_idx.cpu()), shadowing=scene.shadowing, quadrature=q)
     out = torch.zeros(sea.shape, dtype=vals.dtype, device=vals.device)
     return out.index_put((sea,), vals)
 
@@ -661,7 +765,10 @@ def _render_table(
     chunks spread over worker threads by :func:`~roughsea_torch._parallel.map_chunks`. With
     ``brightness`` the result is in kelvin. Returns (B, H, W).
     """
-    iso = bool(((p["vx"] == p["vy"]) & (p["cxy"] == 0)).all())
+    # a textured sea's clutter depends on the view's azimuth through the resolved waves' anisotropy
+    # (and is not even in it): the table then keeps an unfolded azimuth dimension
+    textured = scene.seed is not None
+    iso = not textured and bool(((p["vx"] == p["vy"]) & (p["cxy"] == 0)).all())
     # Uncorrelated anisotropic slopes (Cox–Munk): the table runs over the folded azimuth ψ ∈ [0, π/2].
     # R_a is even in φ̂ there, and as a → 0 (or b → 0) it has a kink at φ̂ = 0 (π/2), where the
     # rms slope along the view, √(a² cos²φ̂ + b² sin²φ̂), → b |sin φ̂|: folded, the kink sits at an
@@ -689,6 +796,11 @@ def _render_table(
     y_z = torch.linspace(-1.0 - ez, 1.0 + ez, Mz, dtype=torch.float64, device=device)
     if scene.path is not None:
         _check_path_altitude(scene.path, altitude)
+    if textured:
+        if cg is None:
+            raise ValueError("geometry=: a textured scene (seed=...) needs the cameras (it places waves in the world); "
+                             "call render(cameras, scene) without geometry=")
+        tex = TextureTable(table, nz, nphi, B, dtype, device, scene, cg)
 
     def one(sl: slice) -> torch.Tensor:
         """Images ``sl``, start to end: spans, the model at the nodes, the fine tables, the pixels;
@@ -732,6 +844,10 @@ def _render_table(
             t_s = t_s * p["air_scale"][sl, None, None].to(t_s.dtype)
         rb = p["rb"][sl, None, None].to(t_s.dtype)
         coarse = (rb - rb * t_rho + t_s).to(dtype)  # R_a at the nodes (b, nz, nphi)
+        if textured:  # the realization's departure from R_a at the nodes, per quantile of the resolved slope
+            wf, lam = tex.field(sl, p)
+            delta = tex.node_delta(sl, p, wf, lam, th_nodes.to(dtype), ph_nodes, coarse, sky, scene, q, altitude,
+                                   earth_radius_m, eps[sl], lo, span_z)
 
         # ---- the fine tables: sea rows [τ L_z | L_path] · [R_a ; 1] · L_oᵀ at ζ = lo + span (y_z + 1)/2,
         # sky rows at cos = s0 + j ds (a ray at the horizontal, cos = 0, where a sea-level sky is
@@ -760,7 +876,7 @@ def _render_table(
             sky_rows = _sky_rows(select_sky(p["sky"], sl), air, scene, s_rows, altitude[sl]).to(dtype)
         else:  # no sky work when no pixel sees sky
             sky_rows = torch.zeros(b_, Ms, dtype=dtype, device=device)
-        if brightness:  # in kelvin at the azimuth nodes, before the azimuth resampling: the
+        if brightness and not textured:  # in kelvin at the azimuth nodes, before the azimuth resampling: the
             # brightness temperature is as smooth in azimuth as the radiance, and this costs
             # (M_z + M_s) × nphi conversions an image instead of one a pixel
             sea_rows = _kelvin(sea_rows, scene.band)
@@ -805,6 +921,13 @@ def _render_table(
         # only to first order; bilinear on the fine table is second order (~1e-7 at 4096 rows).
         vals = F.grid_sample(fine[:, None], torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border",
                              align_corners=True)[:, 0]
+        if textured and delta is not None:
+            cos_t = eps[sl, None, None].to(dtype) * torch.sqrt(q_)
+            o = _azimuth_coordinate(dx, dy, offset, fold)
+            vals = vals + tex.pixels(sl, wf, lam, delta, cos_t, zeta, o, dx, dy, sea, lo, span_z, a, b, altitude,
+                                     earth_radius_m)
+        if textured and brightness:  # per pixel: the texture is added in radiance
+            vals = _kelvin(vals, scene.band)
         return vals
 
     parts = map_chunks(one, [slice(i, min(i + chunk, B)) for i in range(0, B, chunk)], device)

@@ -1,0 +1,330 @@
+"""Two-scale sea clutter: what one pixel of a textured sea sees (``docs/waves.md`` §2–3).
+
+A pixel's footprint splits the waves in two (Bruneton, Neyret & Holzschuch, *Real-time realistic
+ocean lighting using seamless transitions from geometry to BRDF*, CGF 29(2), 2010; the ONERA
+multiresolution infrared sea model, Caillault, Fauqueux et al. 2007–2009):
+
+- the **resolved** waves (longer than the footprint) are geometry: a
+  :class:`~roughsea_torch.waves.WaveField` filtered at the footprint gives the resolved slope at
+  the point the pixel's ray meets;
+- the rest stays **statistical**: the paper's expectation (Eq. 10) about the resolved slope, with the
+  covariance left over, so that resolved and unresolved parts always add up to the scene's
+  :class:`~roughsea_torch.slopes.SlopeStatistics` Σ (Cox–Munk by default).
+
+What is resolved. Of the resolved slope s_r only its component along the line of sight,
+a = s_r · ê (ê the horizontal unit vector from the sea point towards the sensor), is geometry; its
+regression E[s_r | a] = a (ê + κ_r ê⊥) fixes the mean of the unresolved Gaussian, and the residual
+s_r − E[s_r | a] (Gaussian, independent of a) joins the unresolved covariance:
+
+    μ = a' (ê + κ_r ê⊥),      Σ_u = Σ − σ_a² w wᵀ,   w = ê + κ_r ê⊥,   σ_a² = êᵀ Σ_r ê.
+
+So Σ_u + Cov(E[s_r | a]) = Σ exactly. The component across the line of sight tilts the reflected
+ray sideways, which for a sky symmetric in azimuth changes its zenith only to second order; it is
+kept statistical (its radiance effect stays in the mean, its texture is left out).
+
+Which slope a pixel sees (the Eq. 5 weighting of the resolved part). A ray meets a facet in
+proportion to the facet's visible projected area towards the sensor. Sampling the resolved slope
+where the ray meets the mean plane z = 0 gives a ~ N(0, σ_a²), which weights every tilt equally: the
+classic bias, growing towards grazing. The slope the ray actually meets has the density
+
+    p(a') = N(a'; 0, σ_a²) · D_u(a') / D,
+
+D_u(a') the projected area (Eq. 5 denominator) of the unresolved facets about a', D = ∫ N D_u
+that of the total statistics. Then, for any pixel radiance R(a') = R_a(μ(a'), Σ_u) (the shifted
+expectation), ∫ p R da' = R_a(0, Σ): the ensemble mean is the expectation image exactly (Smith's
+visible-slope distribution applied to the resolved scale). :func:`visible_slope` maps the
+flat-point sample monotonically onto p (quantile to quantile): x = a/σ_a ~ N(0, 1) becomes
+a' = F_p⁻¹(Φ(x)). The map is monotone, so the clutter's spatial pattern is the wave field's; only
+its slope histogram leans towards the sensor, most near grazing. What it leaves out: the parallax
+of the resolved waves (the ray meets the crest a little before the flat point) and hiding of one
+resolved wave by another, which a ray-marched first hit would give; near grazing those move where a
+texture feature appears, not the mean.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import torch
+
+from .slopes import SlopeStatistics
+
+__all__ = ["visible_slope", "unresolved_statistics", "pixel_resolved_slope", "along_view", "footprint", "reconcile_scale"]
+
+_SQRT_HALF = math.sqrt(0.5)
+_INV_SQRT_2PI = 1.0 / math.sqrt(2.0 * math.pi)
+
+
+def _projected_area_1d(e: torch.Tensor, s: torch.Tensor) -> torch.Tensor:
+    """E[t H(t)] for t ~ N(e, s²): e Φ(e/s) + s φ(e/s), finite as s → 0 (→ max(e, 0))."""
+    tiny = torch.finfo(e.dtype).tiny
+    ss = s.clamp_min(tiny)
+    z = (e / ss).clamp(-40.0, 40.0)
+    return e * 0.5 * torch.erfc(-z * _SQRT_HALF) + ss * _INV_SQRT_2PI * torch.exp(-0.5 * z * z)
+
+
+def visible_slope(
+    x: torch.Tensor,
+    cos_t: torch.Tensor,
+    sin_t: torch.Tensor,
+    sigma_r: torch.Tensor,
+    sigma_u: torch.Tensor,
+    nodes: int = 1025,
+    width: float = 8.0,
+) -> torch.Tensor:
+    """The resolved along-view slope a' a ray meets, from the flat-point quantile x.
+
+    Args:
+        x: standard-normal quantile of the resolved slope at the flat-sea point, a/σ_a; shape
+            (..., n) (n quantiles per geometry).
+        cos_t, sin_t: cos θ̂ and sin θ̂ of the line of sight, (...).
+        sigma_r: σ_a, rms of the resolved along-view slope, (...), ≥ 0.
+        sigma_u: rms of the unresolved along-view slope (Σ_u's), (...), ≥ 0.
+        nodes: grid of the cumulative distribution (over ±``width`` σ_a).
+
+    Returns:
+        a' (..., n): F_p⁻¹(Φ(x)) with p(a') ∝ N(a'; 0, σ_a²) D_u(a'), D_u(a') = E[t H(t)],
+        t = cos θ̂ + sin θ̂ (a' + σ_u z). Computed on a fixed grid in a'/σ_a (cumulative trapezoid,
+        linear inverse; error ~1e-5 σ_a), differentiable in every argument. σ_a = 0 gives 0.
+    """
+    dtype, device = x.dtype, x.device
+    xi = torch.linspace(-width, width, nodes, dtype=dtype, device=device)
+    ct, st, sr, su = (t[..., None] for t in (cos_t, sin_t, sigma_r, sigma_u))
+    f = torch.exp(-0.5 * xi * xi) * _projected_area_1d(ct + st * sr * xi, st * su)  # (..., nodes)
+    h = 2.0 * width / (nodes - 1)
+    cdf = torch.cat([torch.zeros_like(f[..., :1]), torch.cumsum(0.5 * h * (f[..., 1:] + f[..., :-1]), -1)], -1)
+    cdf = cdf / cdf[..., -1:]
+    q = 0.5 * torch.erfc(-x * _SQRT_HALF)
+    cdf_d = cdf.detach().expand(*q.shape[:-1], nodes).contiguous()
+    i = torch.searchsorted(cdf_d, q.detach().contiguous()).clamp(1, nodes - 1)
+    c0, c1 = torch.gather(cdf.expand_as(cdf_d), -1, i - 1), torch.gather(cdf.expand_as(cdf_d), -1, i)
+    frac = ((q - c0) / (c1 - c0).clamp_min(torch.finfo(dtype).tiny)).clamp(0.0, 1.0)
+    xi_p = -width + h * ((i - 1).to(dtype) + frac)
+    return sigma_r[..., None] * xi_p
+
+
+def unresolved_statistics(
+    vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor, phi: torch.Tensor,
+    var_a: torch.Tensor, kappa: torch.Tensor, a_visible: torch.Tensor,
+) -> SlopeStatistics:
+    """The unresolved Gaussian under a resolved along-view slope a' (module docstring).
+
+    Args:
+        vx, vy, cxy: the scene's total slope covariance (upwind, crosswind frame).
+        phi: φ̂, azimuth of the line of sight (sea → sensor) from the upwind axis [rad].
+        var_a: σ_a², variance of the resolved slope along the line of sight.
+        kappa: κ_r, regression of the resolved across-view slope on a.
+        a_visible: a', the resolved along-view slope the ray meets.
+    All broadcast together.
+
+    Returns:
+        N(μ, Σ − σ_a² w wᵀ) as shifted :class:`SlopeStatistics`, w = ê + κ_r ê⊥ in the upwind frame.
+    """
+    c, s = torch.cos(phi), torch.sin(phi)
+    wx, wy = c - kappa * s, s + kappa * c
+    stats = SlopeStatistics.from_variances(vx - var_a * wx * wx, vy - var_a * wy * wy, cxy - var_a * wx * wy)
+    return stats.shifted(a_visible * wx, a_visible * wy)
+
+
+def along_view(cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], ex: torch.Tensor, ey: torch.Tensor
+               ) -> tuple[torch.Tensor, torch.Tensor]:
+    """(σ_a², κ_r): the variance of a slope field of covariance ``cov`` = (var_x, var_y, cov_xy)
+    along the unit vector ê = (ex, ey), and the regression of its component along ê⊥ (ê turned
+    +90°) on that along ê (0 where σ_a² = 0)."""
+    cxx, cyy, cxy = cov
+    var_a = cxx * ex * ex + 2.0 * cxy * ex * ey + cyy * ey * ey
+    cov_ap = (cyy - cxx) * ex * ey + cxy * (ex * ex - ey * ey)
+    ok = var_a > 1e-30
+    kappa = torch.where(ok, cov_ap / torch.where(ok, var_a, torch.ones_like(var_a)), torch.zeros_like(var_a))
+    return torch.where(ok, var_a, torch.zeros_like(var_a)), kappa
+
+
+def pixel_resolved_slope(
+    slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor],
+    dx: torch.Tensor, dy: torch.Tensor,
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """(x = a/σ_a, σ_a², κ_r) of pixels from the resolved slope (world frame) at their flat-sea
+    point, its covariance (var_x, var_y, cov_xy) and the world components dx, dy of the rays
+    (the line of sight to the sensor is −(dx, dy) horizontally). x = 0 where σ_a = 0."""
+    inv = torch.rsqrt((dx * dx + dy * dy).clamp_min(1e-30))
+    ex, ey = -dx * inv, -dy * inv
+    var_a, kappa = along_view(cov, ex, ey)
+    ok = var_a > 0
+    a = slope_x * ex + slope_y * ey
+    x = torch.where(ok, a * torch.rsqrt(torch.where(ok, var_a, torch.ones_like(var_a))), torch.zeros_like(a))
+    return x, var_a, kappa
+
+
+def footprint(range_m: torch.Tensor, cos_t: torch.Tensor, ifov: torch.Tensor) -> torch.Tensor:
+    """Length [m] of a pixel's footprint on the sea along the view: R δ / cos θ̂ (``docs/waves.md``
+    §4; across the view it is R δ). The window of the resolved waves takes this, the longer side,
+    so no wave shorter than the footprint in any direction is taken as geometry."""
+    return range_m * ifov / cos_t.clamp_min(1e-9)
+
+
+def reconcile_scale(field_cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], vx: torch.Tensor, vy: torch.Tensor,
+                    cxy: torch.Tensor, wind_direction: torch.Tensor, limit: float = 0.8) -> torch.Tensor:
+    """λ (B,) ≤ 1 such that λ² C ≤ ``limit`` · Σ in every direction, C the world-frame covariance of
+    all the wave field's bands, Σ the scene's total slope covariance (upwind frame, its upwind axis
+    at world azimuth ``wind_direction``).
+
+    The two scales must add up to Σ, so the resolved part may never exceed it; a spectrum whose
+    resolved bands carry more slope variance than Σ in some direction (a wind law and a spectrum
+    that disagree) is reconciled by scaling the resolved slopes by λ, and the unresolved part keeps
+    at least 1 − ``limit`` of Σ (the renderer warns when λ < 1).
+    """
+    c, s = torch.cos(wind_direction), torch.sin(wind_direction)
+    cxx, cyy, cc = field_cov  # to the upwind frame: u = x c + y s, v = −x s + y c
+    uu = cxx * c * c + 2 * cc * c * s + cyy * s * s
+    vv = cxx * s * s - 2 * cc * c * s + cyy * c * c
+    uv = (cyy - cxx) * c * s + cc * (c * c - s * s)
+    det = (vx * vy - cxy * cxy).clamp_min(1e-30)
+    # largest eigenvalue of Σ⁻¹ C (2×2): trace and determinant
+    tr = (vy * uu - 2 * cxy * uv + vx * vv) / det
+    dt = (uu * vv - uv * uv) / det
+    lam_max = 0.5 * (tr + torch.sqrt((tr * tr - 4 * dt).clamp_min(0.0)))
+    return torch.sqrt(torch.clamp(limit / lam_max.clamp_min(1e-30), max=1.0))
+
+
+class TextureTable:
+    """The renderer's texture volume for a chunk of images (used by :func:`~roughsea_torch.render.render`).
+
+    Per image, the realization's departure from the expectation, Δ(ζ, o, x) = R(a'(x)) − R_a, at the
+    table's Chebyshev–Lobatto nodes in ζ and azimuth o (those of the mean table) and in the flat-point
+    quantile x of the resolved along-view slope; resampled spectrally to a fine volume (x, ζ, o)
+    times the path transmittance τ(ζ) of each row, read per sea pixel by one trilinear
+    ``grid_sample``. The nodes' footprint, resolved covariance and unresolved Gaussian follow the
+    node's (θ̂, φ̂) and the camera's range at θ̂ (for one camera the range is a function of θ̂);
+    nodes where nothing is resolved (far field) are not evaluated and hold Δ = 0.
+    """
+
+    def __init__(self, table: Any, nz: int, nphi: int, B: int, dtype: torch.dtype, device: torch.device,
+                 scene: Any, cg: Any):
+        from ._validation import per_batch
+        from .render import _lobatto_interp
+
+        self.scene, self.B, self.dtype, self.device = scene, B, dtype, device
+        self.width = float(table.texture_width)
+        xx, Lx, self.ex = _lobatto_interp(int(table.texture), int(table.fine_texture))
+        self.xnodes = torch.as_tensor(xx * self.width, dtype=dtype, device=device)
+        self.Lx = torch.as_tensor(Lx, dtype=dtype, device=device)
+        _, Lz, self.ez = _lobatto_interp(nz, int(table.fine_texture_zenith))
+        self.Lz = torch.as_tensor(Lz, dtype=dtype, device=device)
+        _, La, self.ea = _lobatto_interp(nphi, int(table.fine_texture_azimuth))
+        self.La = torch.as_tensor(La, dtype=dtype, device=device)
+        self.ifov = 1.0 / cg.cameras.fx.to(dtype)  # δ [rad per pixel] at the image centre
+        self.centres = cg.centres.to(dtype)
+        self.time = per_batch("time_s", scene.time_s, B, dtype, device)
+        self._warned = False
+
+    def field(self, sl: slice, p: dict) -> tuple[Any, torch.Tensor]:
+        """The wave field of images ``sl`` and its reconciling scale λ (:func:`reconcile_scale`)."""
+        wf = self.scene.wave_field(self.B, self.dtype, self.device, sl)
+        total = wf.band_covariance().sum(1)  # (b, 3)
+        lam = reconcile_scale((total[:, 0], total[:, 1], total[:, 2]), p["vx"][sl], p["vy"][sl], p["cxy"][sl],
+                              p["wind_direction"][sl])
+        if not self._warned and bool((lam < 1).any()):
+            import warnings
+
+            warnings.warn(f"SeaScene(seed=...): the wave spectrum's resolved slopes exceed 80 % of the scene's slope "
+                          f"statistics in some direction; they are scaled by {float(lam.min()):.3f} so the two scales "
+                          "still add up to SlopeStatistics", stacklevel=4)
+            self._warned = True
+        return wf, lam
+
+    def node_delta(self, sl: slice, p: dict, wf: Any, lam: torch.Tensor, th_nodes: torch.Tensor,
+                   ph_nodes: torch.Tensor, coarse: torch.Tensor, sky: Any, scene: Any, q: Any,
+                   altitude: torch.Tensor, earth_radius_m: float, eps: torch.Tensor, lo: torch.Tensor,
+                   span_z: torch.Tensor) -> torch.Tensor | None:
+        """The fine texture volume (b, fine_texture, fine_texture_zenith, fine_texture_azimuth), τ
+        included; None when no node of the chunk resolves any wave."""
+        from .expectation import _reflection_terms
+        from .render import _sky_per_image, _slant_range
+        from .sky import select_sky
+
+        dtype, device = self.dtype, self.device
+        b_, nz = th_nodes.shape
+        nphi = ph_nodes.shape[1]
+        h = altitude[sl].to(dtype)
+        cos_n, sin_n = torch.cos(th_nodes), torch.sin(th_nodes)
+        L = footprint(_slant_range(cos_n, h[:, None], earth_radius_m), cos_n, self.ifov[sl, None])
+        lam2 = (lam * lam)[:, None, None]
+        cov = tuple(c[:, :, None] * lam2 for c in wf.resolved_covariance(L))  # (b, nz, 1)
+        phw = ph_nodes + p["wind_direction"][sl, None].to(dtype)  # LOS azimuth in the world
+        var_a, kap = along_view(cov, torch.cos(phw)[:, None, :], torch.sin(phw)[:, None, :])  # (b, nz, nphi)
+        vx, vy, cxy = (p[k][sl, None, None] for k in ("vx", "vy", "cxy"))
+        c, s = torch.cos(ph_nodes)[:, None, :], torch.sin(ph_nodes)[:, None, :]
+        suu = vx * c * c + 2.0 * cxy * c * s + vy * s * s
+        active = (var_a > 1e-10 * suu).expand(b_, nz, nphi)
+        if not bool(active.any()):
+            return None
+        idx = active.nonzero(as_tuple=True)
+        img = idx[0]
+        full = lambda t: t.expand(b_, nz, nphi)[idx]  # noqa: E731
+        va_, kp_, su_ = full(var_a), full(kap), full(suu)
+        ct, st = full(cos_n[:, :, None]), full(sin_n[:, :, None])
+        ph = full(ph_nodes[:, None, :])
+        sig_r = torch.sqrt(va_.clamp_min(1e-30))
+        sig_u = torch.sqrt((su_ - va_).clamp_min(1e-30))
+        ap = visible_slope(self.xnodes.expand(img.numel(), -1), ct, st, sig_r, sig_u)  # (M, nx)
+        stats = unresolved_statistics(vx[img, 0], vy[img, 0], cxy[img, 0], ph[:, None], va_[:, None], kp_[:, None], ap)
+        sky_m = _sky_per_image(select_sky(sky_of_chunk(sky, b_), img.cpu()), img.numel(), dtype, device, 1)
+        t_s, t_rho, _ = _reflection_terms(torch.acos(ct.clamp(-1.0, 1.0))[:, None], ph[:, None], stats,
+                                          (p["n"][sl][img, None], p["k"][sl][img, None]), sky_m, scene.shadowing, q, None)
+        if p["air_scale"] is not None:
+            t_s = t_s * p["air_scale"][sl][img, None].to(t_s.dtype)
+        rb = p["rb"][sl][img, None].to(t_s.dtype)
+        v = (rb - rb * t_rho + t_s).to(dtype)
+        delta = torch.zeros(b_, nz, nphi, self.xnodes.numel(), dtype=dtype, device=device)
+        delta = delta.index_put(idx, v - coarse[idx][:, None])
+        vol = torch.einsum("rz,bzpx,ap,fx->bfra", self.Lz, delta, self.La, self.Lx)
+        if scene.path is not None:
+            Mt = self.Lz.shape[0]
+            y = torch.linspace(-1.0 - self.ez, 1.0 + self.ez, Mt, dtype=torch.float64, device=device)
+            cos_rows = (eps[:, None] * torch.sinh(lo[:, None] + span_z[:, None] * (y + 1) / 2)).clamp(0.0, 1.0).to(dtype)
+            tau, _ = scene.path(h[:, None].expand_as(cos_rows), _slant_range(cos_rows, h[:, None], earth_radius_m),
+                                clamp=True)
+            vol = vol * tau.to(dtype)[:, None, :, None]
+        return vol
+
+    def pixels(self, sl: slice, wf: Any, lam: torch.Tensor, vol: torch.Tensor, cos_t: torch.Tensor,
+               zeta: torch.Tensor, o: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, sea: torch.Tensor,
+               lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, altitude: torch.Tensor,
+               earth_radius_m: float) -> torch.Tensor:
+        """The texture of every pixel of images ``sl`` (0 off the sea), (b, H, W)."""
+        import torch.nn.functional as F
+
+        from .render import _slant_range
+
+        dtype = self.dtype
+        h = altitude[sl].to(dtype)[:, None, None]
+        R = _slant_range(cos_t, h, earth_radius_m)
+        L = footprint(R, cos_t, self.ifov[sl, None, None])
+        cen = self.centres[sl]
+        X = cen[:, 0, None, None] + R * dx
+        Y = cen[:, 1, None, None] + R * dy
+        smp = wf.sample(X, Y, self.time[sl], footprint=L, elevation=False)
+        lam_ = lam[:, None, None]
+        cov = tuple(c * (lam_ * lam_) for c in wf.resolved_covariance(L))
+        x, _, _ = pixel_resolved_slope(lam_ * smp["slope_x"], lam_ * smp["slope_y"], cov, dx, dy)
+        gz = x / (self.width * (1.0 + self.ex))
+        gy = (2.0 * (zeta - lo.to(dtype)[:, None, None]) / span_z.to(dtype)[:, None, None] - 1.0) / (1.0 + self.ez)
+        a_, b2 = a.to(dtype)[:, None, None], b.to(dtype)[:, None, None]
+        gx = (2.0 * (o - a_) / (b2 - a_) - 1.0) / (1.0 + self.ea)
+        grid = torch.stack([gx, gy, gz], -1)[:, None]  # (b, 1, H, W, 3): x → W (azimuth), y → H (ζ), z → D (x)
+        out = F.grid_sample(vol[:, None], grid, mode="bilinear", padding_mode="border", align_corners=True)[:, 0, 0]
+        return torch.where(sea, out, torch.zeros_like(out))
+
+
+def sky_of_chunk(sky: Any, b: int) -> Any:
+    """A sky reshaped by the renderer to broadcast over (b, nz, nphi) back to one entry per image."""
+    from .sky import ConstantSky, TabulatedSky
+
+    if isinstance(sky, TabulatedSky) and sky.radiance.ndim > 1:
+        return sky.with_radiance(sky.radiance.reshape(b, sky.radiance.shape[-1]))
+    if isinstance(sky, ConstantSky):
+        r = torch.as_tensor(sky.radiance)
+        if r.ndim > 0:
+            return ConstantSky(r.reshape(b))
+    return sky
