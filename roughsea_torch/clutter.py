@@ -88,9 +88,14 @@ def visible_slope(
         t = cos θ̂ + sin θ̂ (a' + σ_u z). Computed on a fixed grid in a'/σ_a (cumulative trapezoid,
         linear inverse; error ~1e-5 σ_a), differentiable in every argument. σ_a = 0 gives 0.
     """
-    dtype, device = x.dtype, x.device
+    out_dtype, device = x.dtype, x.device
+    # in float64 whatever the dtype: the quantiles at the ends of the node range (x = ±4.5,
+    # 1 − Φ = 3.4e-6) sit where float32's cumulative sum has lost the digits that place them, and a
+    # misplaced end node of the texture's x-interpolant spreads over every x
+    dtype = torch.float64
+    x = x.to(dtype)
     xi = torch.linspace(-width, width, nodes, dtype=dtype, device=device)
-    ct, st, sr, su = (t[..., None] for t in (cos_t, sin_t, sigma_r, sigma_u))
+    ct, st, sr, su = (t.to(dtype)[..., None] for t in (cos_t, sin_t, sigma_r, sigma_u))
     f = torch.exp(-0.5 * xi * xi) * _projected_area_1d(ct + st * sr * xi, st * su)  # (..., nodes)
     h = 2.0 * width / (nodes - 1)
     cdf = torch.cat([torch.zeros_like(f[..., :1]), torch.cumsum(0.5 * h * (f[..., 1:] + f[..., :-1]), -1)], -1)
@@ -101,7 +106,7 @@ def visible_slope(
     c0, c1 = torch.gather(cdf.expand_as(cdf_d), -1, i - 1), torch.gather(cdf.expand_as(cdf_d), -1, i)
     frac = ((q - c0) / (c1 - c0).clamp_min(torch.finfo(dtype).tiny)).clamp(0.0, 1.0)
     xi_p = -width + h * ((i - 1).to(dtype) + frac)
-    return sigma_r[..., None] * xi_p
+    return (sr * xi_p).to(out_dtype)
 
 
 def unresolved_statistics(
@@ -165,14 +170,16 @@ def footprint(range_m: torch.Tensor, cos_t: torch.Tensor, ifov: torch.Tensor) ->
 
 def reconcile_scale(field_cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], vx: torch.Tensor, vy: torch.Tensor,
                     cxy: torch.Tensor, wind_direction: torch.Tensor, limit: float = 0.8) -> torch.Tensor:
-    """λ (B,) ≤ 1 such that λ² C ≤ ``limit`` · Σ in every direction, C the world-frame covariance of
-    all the wave field's bands, Σ the scene's total slope covariance (upwind frame, its upwind axis
-    at world azimuth ``wind_direction``).
+    """λ ≤ 1 such that λ² C ≤ ``limit`` · Σ in every direction, C the world-frame covariance of the
+    resolved slopes at a footprint (:meth:`WaveField.resolved_covariance`), Σ the scene's total slope
+    covariance (upwind frame, its upwind axis at world azimuth ``wind_direction``); all broadcast.
 
-    The two scales must add up to Σ, so the resolved part may never exceed it; a spectrum whose
-    resolved bands carry more slope variance than Σ in some direction (a wind law and a spectrum
-    that disagree) is reconciled by scaling the resolved slopes by λ, and the unresolved part keeps
-    at least 1 − ``limit`` of Σ (the renderer warns when λ < 1).
+    The two scales must add up to Σ, so the resolved part may never exceed it. Where a spectrum's
+    resolved bands carry more slope variance than Σ in some direction (a wind law and a spectrum that
+    disagree; with ECKV against anisotropic Cox–Munk this happens only for footprints of a few
+    centimetres), the resolved slopes there are scaled by λ(footprint), a smooth function of the
+    footprint, and the unresolved part keeps at least 1 − ``limit`` of Σ. The renderer warns when
+    it happens.
     """
     c, s = torch.cos(wind_direction), torch.sin(wind_direction)
     cxx, cyy, cc = field_cov  # to the upwind frame: u = x c + y s, v = −x s + y c
@@ -190,8 +197,8 @@ def reconcile_scale(field_cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], 
 class TextureTable:
     """The renderer's texture volume for a chunk of images (used by :func:`~roughsea_torch.render.render`).
 
-    Per image, the realization's departure from the expectation, Δ(ζ, o, x) = R(a'(x)) − R_a, at the
-    table's Chebyshev–Lobatto nodes in ζ and azimuth o (those of the mean table) and in the flat-point
+    Per image, the realization's departure from the expectation, Δ(ζ, o, x) = R(a'(x)) − R_a, at
+    Chebyshev–Lobatto nodes in ζ (its own), azimuth o (the mean table's) and the flat-point
     quantile x of the resolved along-view slope; resampled spectrally to a fine volume (x, ζ, o)
     times the path transmittance τ(ζ) of each row, read per sea pixel by one trilinear
     ``grid_sample``. The nodes' footprint, resolved covariance and unresolved Gaussian follow the
@@ -209,32 +216,37 @@ class TextureTable:
         xx, Lx, self.ex = _lobatto_interp(int(table.texture), int(table.fine_texture))
         self.xnodes = torch.as_tensor(xx * self.width, dtype=dtype, device=device)
         self.Lx = torch.as_tensor(Lx, dtype=dtype, device=device)
-        _, Lz, self.ez = _lobatto_interp(nz, int(table.fine_texture_zenith))
+        xz, Lz, self.ez = _lobatto_interp(int(table.texture_zenith), int(table.fine_texture_zenith))
+        self.xz = torch.as_tensor(xz, dtype=torch.float64, device=device)
         self.Lz = torch.as_tensor(Lz, dtype=dtype, device=device)
         _, La, self.ea = _lobatto_interp(nphi, int(table.fine_texture_azimuth))
         self.La = torch.as_tensor(La, dtype=dtype, device=device)
         self.ifov = 1.0 / cg.cameras.fx.to(dtype)  # δ [rad per pixel] at the image centre
         self.centres = cg.centres.to(dtype)
         self.time = per_batch("time_s", scene.time_s, B, dtype, device)
+        self.quadrature = tuple(int(v) for v in table.texture_quadrature)
         self._warned = False
 
-    def field(self, sl: slice, p: dict) -> tuple[Any, torch.Tensor]:
-        """The wave field of images ``sl`` and its reconciling scale λ (:func:`reconcile_scale`)."""
-        wf = self.scene.wave_field(self.B, self.dtype, self.device, sl)
-        total = wf.band_covariance().sum(1)  # (b, 3)
-        lam = reconcile_scale((total[:, 0], total[:, 1], total[:, 2]), p["vx"][sl], p["vy"][sl], p["cxy"][sl],
-                              p["wind_direction"][sl])
+    def field(self, sl: slice, p: dict) -> Any:
+        """The wave field of images ``sl``."""
+        return self.scene.wave_field(self.B, self.dtype, self.device, sl)
+
+    def resolved(self, wf: Any, L: torch.Tensor, p: dict, sl: slice) -> tuple[tuple[torch.Tensor, ...], torch.Tensor]:
+        """The reconciled resolved covariance at footprints L (b, ...) and its scale λ (b, ...)."""
+        cov = wf.resolved_covariance(L)
+        ex = (slice(None),) + (None,) * (L.ndim - 1)
+        lam = reconcile_scale(cov, *(p[k][sl][ex] for k in ("vx", "vy", "cxy", "wind_direction")))
         if not self._warned and bool((lam < 1).any()):
             import warnings
 
-            warnings.warn(f"SeaScene(seed=...): the wave spectrum's resolved slopes exceed 80 % of the scene's slope "
-                          f"statistics in some direction; they are scaled by {float(lam.min()):.3f} so the two scales "
-                          "still add up to SlopeStatistics", stacklevel=4)
+            warnings.warn(f"SeaScene(seed=...): at footprints down to {float(L.detach().amin()):.3g} m the wave "
+                          "spectrum's resolved slopes exceed 80 % of the scene's slope statistics in some direction; "
+                          f"they are scaled there (by {float(lam.detach().amin()):.3f} at least) so that the two "
+                          "scales still add up to SlopeStatistics", stacklevel=5)
             self._warned = True
-        return wf, lam
+        return tuple(c * lam * lam for c in cov), lam
 
-    def node_delta(self, sl: slice, p: dict, wf: Any, lam: torch.Tensor, th_nodes: torch.Tensor,
-                   ph_nodes: torch.Tensor, coarse: torch.Tensor, sky: Any, scene: Any, q: Any,
+    def node_delta(self, sl: slice, p: dict, wf: Any, ph_nodes: torch.Tensor, sky: Any, scene: Any, q: Any,
                    altitude: torch.Tensor, earth_radius_m: float, eps: torch.Tensor, lo: torch.Tensor,
                    span_z: torch.Tensor) -> torch.Tensor | None:
         """The fine texture volume (b, fine_texture, fine_texture_zenith, fine_texture_azimuth), τ
@@ -244,13 +256,16 @@ class TextureTable:
         from .sky import select_sky
 
         dtype, device = self.dtype, self.device
-        b_, nz = th_nodes.shape
-        nphi = ph_nodes.shape[1]
+        # the texture's own ζ nodes over the sea rows' span (it varies faster in ζ than the mean:
+        # the resolved scale moves with the footprint, one octave of the spectrum per 0.35 in ζ)
+        b_, nz, nphi = ph_nodes.shape[0], self.xz.numel(), ph_nodes.shape[1]
+        zeta = lo[:, None] + span_z[:, None] * (self.xz + 1) / 2
+        th_nodes = torch.acos((eps[:, None] * torch.sinh(zeta)).clamp(0.0, 1.0)).to(dtype)
         h = altitude[sl].to(dtype)
         cos_n, sin_n = torch.cos(th_nodes), torch.sin(th_nodes)
         L = footprint(_slant_range(cos_n, h[:, None], earth_radius_m), cos_n, self.ifov[sl, None])
-        lam2 = (lam * lam)[:, None, None]
-        cov = tuple(c[:, :, None] * lam2 for c in wf.resolved_covariance(L))  # (b, nz, 1)
+        cov, _ = self.resolved(wf, L, p, sl)
+        cov = tuple(c[:, :, None] for c in cov)  # (b, nz, 1)
         phw = ph_nodes + p["wind_direction"][sl, None].to(dtype)  # LOS azimuth in the world
         var_a, kap = along_view(cov, torch.cos(phw)[:, None, :], torch.sin(phw)[:, None, :])  # (b, nz, nphi)
         vx, vy, cxy = (p[k][sl, None, None] for k in ("vx", "vy", "cxy"))
@@ -268,16 +283,24 @@ class TextureTable:
         sig_r = torch.sqrt(va_.clamp_min(1e-30))
         sig_u = torch.sqrt((su_ - va_).clamp_min(1e-30))
         ap = visible_slope(self.xnodes.expand(img.numel(), -1), ct, st, sig_r, sig_u)  # (M, nx)
-        stats = unresolved_statistics(vx[img, 0], vy[img, 0], cxy[img, 0], ph[:, None], va_[:, None], kp_[:, None], ap)
+        # one more column, the expectation itself (nothing resolved), on the same quadrature: Δ is
+        # the difference of two evaluations whose quadrature errors nearly cancel, so the texture
+        # nodes can take a coarser rule than the mean table (TableSize.texture_quadrature)
+        zero = torch.zeros_like(ap[:, :1])
+        ap = torch.cat([ap, zero], 1)
+        va_col = torch.cat([va_[:, None].expand_as(ap[:, :-1]), zero], 1)
+        stats = unresolved_statistics(vx[img, 0], vy[img, 0], cxy[img, 0], ph[:, None], va_col, kp_[:, None], ap)
         sky_m = _sky_per_image(select_sky(sky_of_chunk(sky, b_), img.cpu()), img.numel(), dtype, device, 1)
+        outer, inner = self.quadrature
         t_s, t_rho, _ = _reflection_terms(torch.acos(ct.clamp(-1.0, 1.0))[:, None], ph[:, None], stats,
-                                          (p["n"][sl][img, None], p["k"][sl][img, None]), sky_m, scene.shadowing, q, None)
+                                          (p["n"][sl][img, None], p["k"][sl][img, None]), sky_m, scene.shadowing,
+                                          q.with_(outer=outer, inner=inner), None)
         if p["air_scale"] is not None:
             t_s = t_s * p["air_scale"][sl][img, None].to(t_s.dtype)
         rb = p["rb"][sl][img, None].to(t_s.dtype)
-        v = (rb - rb * t_rho + t_s).to(dtype)
+        v = rb - rb * t_rho + t_s
         delta = torch.zeros(b_, nz, nphi, self.xnodes.numel(), dtype=dtype, device=device)
-        delta = delta.index_put(idx, v - coarse[idx][:, None])
+        delta = delta.index_put(idx, (v[:, :-1] - v[:, -1:]).to(dtype))
         vol = torch.einsum("rz,bzpx,ap,fx->bfra", self.Lz, delta, self.La, self.Lx)
         if scene.path is not None:
             Mt = self.Lz.shape[0]
@@ -288,7 +311,7 @@ class TextureTable:
             vol = vol * tau.to(dtype)[:, None, :, None]
         return vol
 
-    def pixels(self, sl: slice, wf: Any, lam: torch.Tensor, vol: torch.Tensor, cos_t: torch.Tensor,
+    def pixels(self, sl: slice, p: dict, wf: Any, vol: torch.Tensor, cos_t: torch.Tensor,
                zeta: torch.Tensor, o: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, sea: torch.Tensor,
                lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, altitude: torch.Tensor,
                earth_radius_m: float) -> torch.Tensor:
@@ -305,9 +328,8 @@ class TextureTable:
         X = cen[:, 0, None, None] + R * dx
         Y = cen[:, 1, None, None] + R * dy
         smp = wf.sample(X, Y, self.time[sl], footprint=L, elevation=False)
-        lam_ = lam[:, None, None]
-        cov = tuple(c * (lam_ * lam_) for c in wf.resolved_covariance(L))
-        x, _, _ = pixel_resolved_slope(lam_ * smp["slope_x"], lam_ * smp["slope_y"], cov, dx, dy)
+        cov, lam = self.resolved(wf, L, p, sl)
+        x, _, _ = pixel_resolved_slope(lam * smp["slope_x"], lam * smp["slope_y"], cov, dx, dy)
         gz = x / (self.width * (1.0 + self.ex))
         gy = (2.0 * (zeta - lo.to(dtype)[:, None, None]) / span_z.to(dtype)[:, None, None] - 1.0) / (1.0 + self.ez)
         a_, b2 = a.to(dtype)[:, None, None], b.to(dtype)[:, None, None]

@@ -337,11 +337,15 @@ class TableSize:
             zenith over the span of the image's sky pixels.
         span: ``"pixels"`` (default): nodes only over the angles the image's sea pixels span;
             ``"full"``: over every angle (θ̂ in [0°, 90°], every azimuth), for comparison.
+        texture_zenith: ζ nodes of the texture (the mean table's ``zenith`` is too few for it: 21
+            left 5 % of the texture's amplitude, 33 leave 0.6 %; ``tests/test_clutter.py``).
         texture: nodes in x = a/σ_a, the flat-point quantile of the resolved along-view slope
             (textured scenes, :mod:`roughsea_torch.clutter`), Chebyshev–Lobatto over
             ±``texture_width``; beyond it (|x| > 4.5: 7e-6 of the pixels) the border value.
         fine_texture, fine_texture_zenith, fine_texture_azimuth: the fine texture volume
             (x, ζ, azimuth) read by one trilinear ``grid_sample`` per sea pixel.
+        texture_quadrature: (outer, inner) Gauss–Legendre nodes of the model at the texture nodes
+            (the departure from the mean is the difference of two evaluations on this rule).
     """
 
     zenith: int = 21
@@ -354,15 +358,17 @@ class TableSize:
     zenith_thin: int = 41
     fine_azimuth_thin: int = 128
     texture: int = 9
+    texture_zenith: int = 33
     texture_width: float = 4.5
-    fine_texture: int = 33
+    fine_texture: int = 129
     fine_texture_zenith: int = 512
     fine_texture_azimuth: int = 16
+    texture_quadrature: tuple = (20, 16)
 
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):
             raise ValueError(f"TableSize.span must be 'pixels' or 'full'; got {self.span!r}")
-        for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin", "texture"):
+        for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin", "texture", "texture_zenith"):
             if int(getattr(self, name)) < 2:
                 raise ValueError(f"TableSize.{name} must be >= 2")
         for name in ("fine_zenith", "fine_azimuth", "fine_sky", "fine_azimuth_thin", "fine_texture",
@@ -694,8 +700,6 @@ def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str
 
     sea = geom.is_sea
     wf = scene.wave_field(B, dtype, device)
-    total = wf.band_covariance().sum(1)
-    lam = reconcile_scale((total[:, 0], total[:, 1], total[:, 2]), p["vx"], p["vy"], p["cxy"], p["wind_direction"])
     centres = -(cameras.rotation_matrix.transpose(-1, -2) @ cameras.translation_vector)[..., 0].to(dtype)
     cos_t = geom.cos_view_zenith.clamp_min(1e-9)
     R = torch.where(sea, geom.range_m, torch.ones_like(cos_t))
@@ -704,9 +708,10 @@ def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str
     time = per_batch("time_s", scene.time_s, B, dtype, device)
     smp = wf.sample(centres[:, 0, None, None] + R * dx, centres[:, 1, None, None] + R * dy, time, footprint=L,
                     elevation=False)
-    l_ = lam[:, None, None]
-    x, var_a, kap = pixel_resolved_slope(l_ * smp["slope_x"], l_ * smp["slope_y"],
-                                         tuple(c * l_ * l_ for c in wf.resolved_covariance(L)), dx, dy)
+    cov = wf.resolved_covariance(L)
+    l_ = reconcile_scale(cov, *(p[k][:, None, None] for k in ("vx", "vy", "cxy", "wind_direction")))
+    x, var_a, kap = pixel_resolved_slope(l_ * smp["slope_x"], l_ * smp["slope_y"], tuple(c * l_ * l_ for c in cov),
+                                         dx, dy)
     img_idx = torch.arange(B, device=device)[:, None, None].expand_as(sea)[sea]
     th, ph = geom.view_zenith[sea], _relative_azimuth(geom, p)[sea]
     vx, vy, cxy = p["vx"][img_idx], p["vy"][img_idx], p["cxy"][img_idx]
@@ -845,8 +850,8 @@ def _render_table(
         rb = p["rb"][sl, None, None].to(t_s.dtype)
         coarse = (rb - rb * t_rho + t_s).to(dtype)  # R_a at the nodes (b, nz, nphi)
         if textured:  # the realization's departure from R_a at the nodes, per quantile of the resolved slope
-            wf, lam = tex.field(sl, p)
-            delta = tex.node_delta(sl, p, wf, lam, th_nodes.to(dtype), ph_nodes, coarse, sky, scene, q, altitude,
+            wf = tex.field(sl, p)
+            delta = tex.node_delta(sl, p, wf, ph_nodes, sky, scene, q, altitude,
                                    earth_radius_m, eps[sl], lo, span_z)
 
         # ---- the fine tables: sea rows [τ L_z | L_path] · [R_a ; 1] · L_oᵀ at ζ = lo + span (y_z + 1)/2,
@@ -924,7 +929,7 @@ def _render_table(
         if textured and delta is not None:
             cos_t = eps[sl, None, None].to(dtype) * torch.sqrt(q_)
             o = _azimuth_coordinate(dx, dy, offset, fold)
-            vals = vals + tex.pixels(sl, wf, lam, delta, cos_t, zeta, o, dx, dy, sea, lo, span_z, a, b, altitude,
+            vals = vals + tex.pixels(sl, p, wf, delta, cos_t, zeta, o, dx, dy, sea, lo, span_z, a, b, altitude,
                                      earth_radius_m)
         if textured and brightness:  # per pixel: the texture is added in radiance
             vals = _kelvin(vals, scene.band)

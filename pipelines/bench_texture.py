@@ -1,0 +1,155 @@
+"""Speed and memory of textured seas (``SeaScene(seed=...)``) against the expectation images, in one run.
+
+The README's default scene (LOWTRAN7 midlatitude-summer sky, path on, radiance), 16 images 512×640,
+float32, each with its own wind, direction, sea temperature and camera pose (altitude 10–500 m,
+pitch −8…−1°; ``bench_render.batch``), rendered as expectation images and as textured realizations
+(one seed per image), with 1 and 2 torch threads. Median of ``--repeats`` runs; the ratio is
+textured / expectation timed in the same run. Then peak resident memory of each (separate
+processes, sampled every millisecond over the resident memory just before the render), against
+the output's size, and where the textured render's time goes (1 thread).
+
+Usage:
+    python pipelines/bench_texture.py [--repeats 5] [--out docs]
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import json
+import os
+import platform
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import torch
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_render import B, H, W, _rss_mb, batch, med  # noqa: E402
+
+import roughsea_torch as rs  # noqa: E402
+
+
+def scenes(b: int = B):
+    cam, sc = batch(b)
+    cams = rs.make_camera(H, W, **cam)
+    return cams, rs.SeaScene(**sc), rs.SeaScene(**sc, seed=list(range(b)), time_s=12.5)
+
+
+def memory_child(kind: str) -> None:
+    cam, sc = batch(B)
+    small = rs.make_camera(8, 8, **{k: v[:1] for k, v in cam.items()})
+    extra = dict(seed=[0]) if kind == "textured" else {}
+    rs.render(small, rs.SeaScene(**{k: v[:1] for k, v in sc.items()}, **extra))
+    cams = rs.make_camera(H, W, **cam)
+    scene = rs.SeaScene(**sc, **(dict(seed=list(range(B)), time_s=12.5) if kind == "textured" else {}))
+    base = _rss_mb()
+    peak = [base]
+    done = threading.Event()
+
+    def poll() -> None:
+        while not done.is_set():
+            peak[0] = max(peak[0], _rss_mb())
+            time.sleep(0.001)
+
+    t = threading.Thread(target=poll)
+    t.start()
+    img = rs.render(cams, scene)
+    done.set()
+    t.join()
+    peak[0] = max(peak[0], _rss_mb())
+    print(json.dumps({"peak_mb": peak[0] - base, "output_mb": img.numel() * img.element_size() / 2**20}))
+
+
+def stages(cams, textured) -> list[tuple[str, float]]:
+    """Self time of the textured render's main parts (1 thread, torch profiler's CPU totals)."""
+    from torch.profiler import ProfilerActivity, profile, record_function
+
+    import roughsea_torch.clutter as cl
+
+    wrapped = {}
+    for name in ("node_delta", "pixels"):
+        f = getattr(cl.TextureTable, name)
+
+        def w(self, *a, _f=f, _n=name, **k):
+            with record_function(f"texture.{_n}"):
+                return _f(self, *a, **k)
+
+        wrapped[name] = f
+        setattr(cl.TextureTable, name, w)
+    try:
+        rs.render(cams, textured)
+        with profile(activities=[ProfilerActivity.CPU]) as prof:
+            t0 = time.perf_counter()
+            with record_function("render"):
+                rs.render(cams, textured)
+            total = time.perf_counter() - t0
+    finally:
+        for name, f in wrapped.items():
+            setattr(cl.TextureTable, name, f)
+    ev = {e.key: e.cpu_time_total / 1e6 for e in prof.key_averages() if e.key.startswith(("texture.", "render"))}
+    return [("whole render", total)] + [(k, v) for k, v in sorted(ev.items()) if k != "render"]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--out", default="docs")
+    ap.add_argument("--memory-child", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.memory_child:
+        memory_child(args.memory_child)
+        return
+    cams, mean_scene, tex_scene = scenes()
+    lines = [f"# Textured seas against expectation images ({dt.date.today()}, {platform.processor() or platform.machine()}, "
+             f"torch {torch.__version__}, {os.cpu_count()} cores)", "",
+             f"16 images {H}×{W} float32, README default scene (LOWTRAN7 sky, path, radiance), median of {args.repeats}; "
+             "`python pipelines/bench_texture.py`", "",
+             "| threads | expectation [s] | textured [s] | textured / expectation |", "|---:|---:|---:|---:|"]
+    rows = []
+    for threads in (1, 2):
+        torch.set_num_threads(threads)
+        t_mean = med(lambda: rs.render(cams, mean_scene), args.repeats)
+        t_tex = med(lambda: rs.render(cams, tex_scene), args.repeats)
+        rows.append((threads, t_mean, t_tex))
+        lines.append(f"| {threads} | {t_mean:.3f} | {t_tex:.3f} | {t_tex / t_mean:.2f} |")
+        print(lines[-1], file=sys.stderr)
+    lines += ["", "Peak resident memory over the process's before the render (separate processes):", "",
+              "| render | peak [MB] | output [MB] | peak / output |", "|---|---:|---:|---:|"]
+    for kind in ("expectation", "textured"):
+        out = subprocess.run([sys.executable, __file__, "--memory-child", kind], capture_output=True, text=True,
+                             check=True, env=dict(os.environ, OMP_NUM_THREADS="2"))
+        m = json.loads(out.stdout.strip().splitlines()[-1])
+        lines.append(f"| {kind} | {m['peak_mb']:.0f} | {m['output_mb']:.0f} | {m['peak_mb'] / m['output_mb']:.1f} |")
+    torch.set_num_threads(1)
+    lines += ["", "Where the textured render's time goes (1 thread, profiler CPU totals):", "", "| part | s |", "|---|---:|"]
+    lines += [f"| {k} | {v:.3f} |" for k, v in stages(cams, tex_scene)]
+    report = "\n".join(lines) + "\n"
+    print(report)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "bench_texture.md").write_text(report)
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(5, 3.2))
+        x = range(len(rows))
+        ax.bar([i - 0.2 for i in x], [r[1] for r in rows], 0.4, label="expectation")
+        ax.bar([i + 0.2 for i in x], [r[2] for r in rows], 0.4, label="textured")
+        ax.set_xticks(list(x), [f"{r[0]} thread{'s' if r[0] > 1 else ''}" for r in rows])
+        ax.set_ylabel("seconds for 16 × 512×640")
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(out / "bench_texture.png", dpi=120)
+    except ImportError:
+        pass
+
+
+if __name__ == "__main__":
+    main()
