@@ -37,7 +37,9 @@ from .geometry import EARTH_RADIUS_M, ViewGeometry, make_camera, view_geometry
 from .render import SeaRenderer, SeaScene, TableSize, render
 from .sensitivity import pixel_derivative
 from .slopes import SlopeStatistics, slope_pdf
-from . import atmosphere, augmentation, dataset, sensor  # noqa: E402  (submodules as attributes: rs.sensor, ...)
+from .waves import WaveField, elfouhaily_spectrum
+from .motion import PlatformMotion, render_clip
+from . import atmosphere, augmentation, clutter, dataset, sensor, waves  # noqa: E402  (submodules as attributes: rs.sensor, ...)
 from .augmentation import RandomSeaBackground, SceneSampler
 from .dataset import SeaShardDataset
 from .sensor import SensorModel
@@ -47,6 +49,12 @@ __version__ = "0.1.0"
 __all__ = [
     "atmosphere",
     "augmentation",
+    "clutter",
+    "waves",
+    "WaveField",
+    "PlatformMotion",
+    "elfouhaily_spectrum",
+    "render_clip",
     "dataset",
     "sensor",
     "EARTH_RADIUS_M",

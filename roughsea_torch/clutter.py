@@ -239,10 +239,11 @@ class TextureTable:
         if not self._warned and bool((lam < 1).any()):
             import warnings
 
-            warnings.warn(f"SeaScene(seed=...): at footprints down to {float(L.detach().amin()):.3g} m the wave "
-                          "spectrum's resolved slopes exceed 80 % of the scene's slope statistics in some direction; "
-                          f"they are scaled there (by {float(lam.detach().amin()):.3f} at least) so that the two "
-                          "scales still add up to SlopeStatistics", stacklevel=5)
+            # one fixed text, so Python's default filter shows it once per session, not once a batch
+            warnings.warn("SeaScene(seed=...): where a pixel's footprint resolves more slope variance in the wave "
+                          "spectrum than the scene's slope law allows (ECKV against Cox-Munk: light winds, "
+                          "centimetre footprints), the resolved slopes are scaled down so that the two scales still "
+                          "add up to SlopeStatistics (roughsea_torch.clutter.reconcile_scale)", stacklevel=5)
             self._warned = True
         return tuple(c * lam * lam for c in cov), lam
 

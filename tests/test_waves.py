@@ -1,0 +1,533 @@
+"""Wave spectrum (Elfouhaily et al. 1997) and the synthesized band-split sea surface (roughsea_torch.waves).
+
+Each test asserts a fact that a wrong implementation would break; the sources of the reference values
+are given next to them. The module runs single-threaded (restored afterwards): on a shared 2-core
+machine OpenMP spin-waiting makes the many small per-image ops of WaveField erratic; the
+determinism test switches to 2 threads itself to cover the parallel code paths.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import torch
+
+import roughsea_torch.waves as waves
+from roughsea_torch.waves import (
+    C_M,
+    GRAVITY,
+    K_M,
+    WaveBands,
+    WaveField,
+    dispersion,
+    elfouhaily_omnidirectional,
+    elfouhaily_spectrum,
+    elfouhaily_spreading,
+)
+
+DTYPES = [torch.float32, torch.float64]
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _one_thread():
+    n = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(n)
+
+
+def _trapz(f: torch.Tensor, k: torch.Tensor) -> float:
+    return float(torch.trapezoid(f, k))
+
+
+def _w125(u10: float) -> float:
+    """Wind at 12.5 m (Cox & Munk's anemometer) from U10 by the log profile with ECKV's z0 (Eq. 66)."""
+    z0 = 3.7e-5 * u10**2 / GRAVITY * 0.84**0.9
+    return u10 * math.log(12.5 / z0) / math.log(10.0 / z0)
+
+
+# ------------------------------------------------------------------------------------------------
+# 1. The spectrum against published facts
+# ------------------------------------------------------------------------------------------------
+K = torch.logspace(-4, 4, 200_001, dtype=torch.float64)
+
+
+@pytest.mark.parametrize("u10", [5.0, 10.0, 20.0])
+def test_omnidirectional_peak_at_kp(u10):
+    """ECKV Eq. 3: k_p = g Ω_c²/U10² (Ω_c = 0.84). The maximum of S(k) lies 2.3 % below k_p, pulled
+    down by the long-wave side factor exp(−Ω/√10 (√(k/k_p) − 1)) of Eq. 32; 5 % tolerance."""
+    kp = GRAVITY * 0.84**2 / u10**2
+    s = elfouhaily_omnidirectional(K, u10)
+    k_peak = float(K[s.argmax()])
+    assert abs(k_peak / kp - 1.0) < 0.05
+    assert 0.0 < float(s[K < 0.5 * kp].max()) < 0.2 * float(s.max())  # a single, sharp peak
+
+
+@pytest.mark.parametrize("u10", [5.0, 10.0, 20.0])
+def test_significant_height_near_pierson_moskowitz(u10):
+    """Fully developed sea (Ω_c = 0.84): Hs = 4 √∫S dk against Pierson & Moskowitz (1964).
+
+    PM: S(f) = α g² (2π)⁻⁴ f⁻⁵ exp(−β (f₀/f)⁴), α = 0.0081, β = 0.74, f₀ = g / (2π U19.5), so
+    ⟨η²⟩ = α U19.5⁴ / (4 β g²) and Hs = 0.2092 U19.5²/g; U19.5 = 1.026 U10 (Mobley, Ocean Optics Web
+    Book, "Wave variance spectra: examples"). ECKV's long-wave branch is JONSWAP-shaped (γ = 1.7 even
+    when fully developed, Eq. 3) with α_p = 6e-3 √Ω (Eq. 34), not PM's α, so it need not coincide:
+    measured +13 % (long-wave part) to +16 % (with the short-wave part). Tolerance ±20 %; a factor 2
+    in the variance normalization would move Hs by 41 %.
+    """
+    hs = 4.0 * math.sqrt(_trapz(elfouhaily_omnidirectional(K, u10), K))
+    hs_pm = 0.2092 * (1.026 * u10) ** 2 / GRAVITY
+    assert abs(hs / hs_pm - 1.0) < 0.20
+
+
+@pytest.mark.parametrize("u10", [5.0, 10.0, 15.0])
+@pytest.mark.parametrize("k_max", [1e3, 1e4])
+def test_mean_square_slope_within_cox_munk(u10, k_max):
+    """Slope variances against Cox & Munk (1954, clean surface, W at 12.5 m):
+    total 0.003 + 5.12e-3 W ± 0.004, upwind 3.16e-3 W ± 0.004, crosswind 0.003 + 1.92e-3 W ± 0.002.
+
+    ECKV's short-wave level α_m (Eq. 44) was set so that the spectrum agrees with Cox & Munk's in situ
+    slopes (ECKV abstract: the criteria include "agreement with in situ observations of Cox and Munk
+    [1954]"). Tolerance: twice CM's quoted scatter. Measured (k ≤ 1e3): total +0.003/+0.006/+0.002
+    at 5/10/15 m/s. Upwind and crosswind come from integrating the directional F(k, φ) over φ, so the
+    spreading (Eq. 57) and its normalization are tested too; upwind must exceed crosswind.
+    """
+    w = _w125(u10)
+    k = torch.logspace(-3, math.log10(k_max), 4001, dtype=torch.float64)
+    phi = torch.arange(64, dtype=torch.float64) * (2 * math.pi / 64)
+    f = elfouhaily_spectrum(k[:, None], phi[None, :], u10)  # φ from downwind
+    dphi = 2 * math.pi / 64
+    up = _trapz(k**3 * (f * torch.cos(phi) ** 2).sum(1) * dphi, k)
+    cross = _trapz(k**3 * (f * torch.sin(phi) ** 2).sum(1) * dphi, k)
+    total = _trapz(k**2 * elfouhaily_omnidirectional(k, u10), k)
+    assert up + cross == pytest.approx(total, rel=1e-9)
+    assert up > 1.2 * cross
+    assert abs(total - (0.003 + 5.12e-3 * w)) <= 2 * 0.004
+    assert abs(up - 3.16e-3 * w) <= 2 * 0.004
+    assert abs(cross - (0.003 + 1.92e-3 * w)) <= 2 * 0.002
+
+
+@pytest.mark.parametrize("dtype", DTYPES)
+def test_spreading_integrates_to_one(dtype):
+    """(1 + Δ cos 2φ)/(2π) integrates to 1 over [0, 2π) (ECKV Eq. 49): ∫ F(k, φ) k dφ = S(k)."""
+    k = torch.logspace(-3, 3.5, 57, dtype=dtype)
+    phi = torch.arange(32, dtype=dtype) * (2 * math.pi / 32)
+    f = elfouhaily_spectrum(k[:, None], phi[None, :], 12.0)
+    s = elfouhaily_omnidirectional(k, 12.0)
+    assert f.dtype == dtype
+    torch.testing.assert_close((f * k[:, None]).sum(1) * (2 * math.pi / 32), s, rtol=1e-5 if dtype == torch.float32 else 1e-12, atol=0)
+    delta = elfouhaily_spreading(k, 12.0)
+    assert bool(((delta > 0) & (delta <= 1)).all())
+    # long waves are narrow (Δ → 1), short gravity waves broader
+    assert float(delta[0]) > 0.99 and float(delta[torch.argmin((k - 30.0).abs())]) < 0.6
+
+
+def test_dispersion_capillary_minimum():
+    """ω² = g k (1 + (k/k_m)²): phase speed minimum √(2 g / k_m) ≈ 0.23 m/s at k_m (ECKV Eq. 24)."""
+    k = torch.tensor([0.5 * K_M, K_M, 2.0 * K_M], dtype=torch.float64)
+    c = dispersion(k) / k
+    assert float(c[1]) == pytest.approx(C_M, abs=1e-3)
+    assert float(c[1]) < float(c[0]) and float(c[1]) < float(c[2])
+    assert float(dispersion(torch.tensor(0.01, dtype=torch.float64))) == pytest.approx(math.sqrt(GRAVITY * 0.01), rel=1e-8)
+
+
+# ------------------------------------------------------------------------------------------------
+# 2. Slope covariance of the synthesized field
+# ------------------------------------------------------------------------------------------------
+def test_sampled_covariance_matches_band_covariance():
+    """Slope moments s_x², s_y², s_x s_y of the sampled field, averaged over 4096 uniform random points
+    per seed and 240 seeds, equal Σ_o band_covariance (footprint 0, i.e. every band at full weight)
+    and resolved_covariance(footprint) for footprints 2, 5 and 30 cm, to 2 %, the 2 % being more than
+    4 standard errors (from the spread across seeds; one realization of the default layout scatters
+    by about 5 % around the expectation: ~75 independent amplitudes per band).
+
+    The four footprints are evaluated at the same points (the points are repeated), in one call.
+    Float32 only: the identity is the same in float64 (dtype agreement is tested separately)."""
+    dtype = torch.float32
+    n_seeds, group, npts = 240, 60, 4096
+    footprints = [0.0, 0.02, 0.05, 0.3]
+    gen = torch.Generator().manual_seed(1)
+    est, ref = [], []  # per seed: (footprint, moment) pairs
+    for start in range(0, n_seeds, group):
+        field = WaveField(torch.full((group,), 10.0), list(range(start, start + group)), wind_direction=0.7, dtype=dtype)
+        side = field.bands.tile_length[0]  # every tile length divides it: uniform on every tile
+        x = (torch.rand(group, npts, generator=gen, dtype=torch.float64) * side).to(dtype)
+        y = (torch.rand(group, npts, generator=gen, dtype=torch.float64) * side).to(dtype)
+        fp = torch.tensor(footprints, dtype=dtype).repeat_interleave(npts).expand(group, -1)
+        out = field.sample(x.repeat(1, 4), y.repeat(1, 4), time_s=3.0, footprint=fp, elevation=False)
+        sx = out["slope_x"].view(group, 4, npts).double()
+        sy = out["slope_y"].view(group, 4, npts).double()
+        est.append(torch.stack([(sx * sx).mean(-1), (sy * sy).mean(-1), (sx * sy).mean(-1)], -1))
+        vx, vy, cxy = (v.view(group, 4, npts)[..., 0].double() for v in field.resolved_covariance(fp))
+        ref.append(torch.stack([vx, vy, cxy], -1))
+        if start == 0:
+            total = field.band_covariance().sum(1).double()
+            assert total.shape == (group, 3) and field.band_covariance().dtype == dtype
+            torch.testing.assert_close(ref[0][:, 0], total, rtol=1e-6, atol=0)  # footprint 0: all bands
+            assert abs(float(total[:, 0].mean() / total[:, 1].mean()) - 1.0) > 0.05  # anisotropic
+    est, ref = torch.cat(est), torch.cat(ref)  # (n_seeds, 4 footprints, 3 moments)
+    scale = torch.stack([ref[..., 0], ref[..., 1], torch.sqrt(ref[..., 0] * ref[..., 1])], -1)
+    err = (est - ref) / scale  # per seed, relative to the variance scale
+    mean, se = err.mean(0), err.std(0) / math.sqrt(n_seeds)
+    assert bool((4 * se < 0.02).all()), f"test too noisy: standard errors {se}"
+    assert bool((mean.abs() < 0.02).all()), f"relative errors {mean} (standard errors {se})"
+    # the footprints do remove variance, progressively
+    vx = ref[..., 0].mean(0)
+    assert bool((vx[1:] < vx[:-1]).all()) and float(vx[-1]) > 0
+
+
+def _lattice_covariance(bands: WaveBands, wind: float, wind_direction: float, bilinear: bool = True) -> torch.Tensor:
+    """Σ over each band's lattice modes of F(k, φ) Δk² k kᵀ (× the bilinear factor), rebuilt from the
+    public spectrum: modes k = Δk (i, j), inner_radius ≤ |(i, j)| < inner_radius · k⁺/k⁻."""
+    out = []
+    for o in range(bands.n_bands):
+        dk, n = bands.fundamental[o], bands.tile_size
+        ratio = bands.k_edges[o + 1] / bands.k_edges[o]
+        m = math.ceil(bands.inner_radius * ratio)
+        idx = torch.arange(-m, m + 1, dtype=torch.float64)
+        i, j = torch.meshgrid(idx, idx, indexing="xy")
+        r2 = i**2 + j**2
+        keep = (r2 >= bands.inner_radius**2) & (r2 < (bands.inner_radius * ratio) ** 2)
+        kx, ky = i[keep] * dk, j[keep] * dk
+        phi = torch.atan2(ky, kx) - (wind_direction + math.pi)  # from downwind
+        v = elfouhaily_spectrum(torch.sqrt(kx**2 + ky**2), phi, wind) * dk**2
+        if bilinear:
+            v = v * (2 + torch.cos(2 * math.pi * i[keep] / n)) * (2 + torch.cos(2 * math.pi * j[keep] / n)) / 9
+        out.append(torch.stack([(v * kx * kx).sum(), (v * ky * ky).sum(), (v * kx * ky).sum()]))
+    return torch.stack(out)
+
+
+@pytest.mark.parametrize("bands", [WaveBands(), WaveBands(k_edges=(3.0, 5.0, 9.0), tile_size=64, inner_radius=5.0)])
+def test_band_covariance_is_the_lattice_sum(bands):
+    """band_covariance = Σ over the band's discrete modes of F(k, φ) Δk² k kᵀ × (2 + cos θx)(2 + cos θy)/9
+    (the position-averaged bilinear factor), in the world frame for wind_direction 0.7 rad."""
+    field = WaveField(torch.tensor([9.0, 14.0], dtype=torch.float64), [0, 1], wind_direction=0.7, dtype=torch.float64, bands=bands)
+    for b, wind in enumerate((9.0, 14.0)):
+        ref = _lattice_covariance(bands, wind, 0.7)
+        torch.testing.assert_close(field.band_covariance()[b], ref, rtol=1e-10, atol=1e-12 * float(ref.abs().max()))
+    assert field.band_wavenumber.shape == (bands.n_bands,)
+    torch.testing.assert_close(field.band_wavenumber[0], torch.tensor(math.sqrt(bands.k_edges[0] * bands.k_edges[1]), dtype=torch.float64))
+
+
+def test_bilinear_correction_on_a_coarse_tile():
+    """On a coarse tile the interpolation loss is large (modes up to θ = 1.57 rad per texel): the sampled
+    slope variance at uniform random points matches band_covariance (which includes the factor) to
+    3 % (> 4 standard errors over 150 seeds), while the uncorrected lattice sum is more than 10 % off."""
+    bands = WaveBands(k_edges=(2.0, 4.0), tile_size=64, inner_radius=8.0)  # ~600 modes, θ ≤ 16·2π/64
+    n_seeds, npts = 150, 4096
+    field = WaveField(torch.full((n_seeds,), 10.0), list(range(n_seeds)), wind_direction=0.3, dtype=torch.float32, bands=bands)
+    gen = torch.Generator().manual_seed(11)
+    side = bands.tile_length[0]
+    x = torch.rand(n_seeds, npts, generator=gen) * side
+    y = torch.rand(n_seeds, npts, generator=gen) * side
+    out = field.sample(x, y, time_s=0.0, elevation=False)
+    cov = field.band_covariance()[:, 0].double()
+    for c, key in enumerate(("slope_x", "slope_y")):
+        err = out[key].double().pow(2).mean(1) / cov[:, c] - 1
+        mean, se = float(err.mean()), float(err.std() / math.sqrt(n_seeds))
+        assert 4 * se < 0.03 and abs(mean) < 0.03, (key, mean, se)
+    uncorrected = _lattice_covariance(bands, 10.0, 0.3, bilinear=False)[0]
+    assert float(uncorrected[0] / cov[0, 0]) > 1.10
+
+
+def test_footprint_none_equals_zero_footprint():
+    field = WaveField(torch.tensor([7.0, 11.0]), [3, 4], wind_direction=torch.tensor([0.0, 1.0]))
+    x = torch.rand(2, 3000, generator=torch.Generator().manual_seed(3)) * 80
+    a = field.sample(x, x.flip(-1), 1.0)
+    b = field.sample(x, x.flip(-1), 1.0, footprint=torch.zeros(()))
+    for key in a:
+        assert torch.equal(a[key], b[key])
+
+
+def test_band_weights_window():
+    """band_weights: 1 at f = 0, 0 at f = inf, monotone and C¹ in log f, one octave wide around
+    k_o f = π (1 below 0.707 π, 0 above 1.414 π), finite gradients (also at inf)."""
+    field = WaveField(10.0, 0, dtype=torch.float64)
+    k0 = float(field.band_wavenumber[5])
+    f = torch.cat([torch.tensor([0.0, math.inf]), torch.logspace(-4, 4, 4001)]).to(torch.float64).requires_grad_()
+    w = field.band_weights(f)
+    assert w.shape == (f.shape[0], field.n_bands)
+    assert bool((w[0] == 1).all()) and bool((w[1] == 0).all())
+    assert bool(((w >= 0) & (w <= 1)).all())
+    w5 = w[2:, 5].detach()
+    assert bool((w5[1:] <= w5[:-1]).all())  # monotone non-increasing in f
+    u = f[2:].detach() * k0 / math.pi
+    assert bool((w5[u <= 0.7] == 1).all()) and bool((w5[u >= 1.42] == 0).all())
+    inside = (u > 0.75) & (u < 1.35)
+    assert bool(((w5[inside] > 0) & (w5[inside] < 1)).all())
+    w.sum().backward()
+    assert bool(torch.isfinite(f.grad).all())
+    # C¹ in log f: dw/dlog f has no jump (it is 0 at both ends of the transition). On this grid
+    # (Δ log f = 0.0046) a C¹ window changes dw/dlog f by ≤ 0.1 per step; a C⁰ ramp would jump by 1.4.
+    dw = torch.diff(w5) / math.log(10 ** (8 / 4000))
+    assert float(dw.abs().max()) > 1.0  # the transition is resolved by the grid
+    assert float(torch.diff(dw).abs().max()) < 0.2
+    # resolved covariance: f = 0 → everything, f = inf → nothing
+    vx, vy, cxy = field.resolved_covariance(torch.tensor([0.0], dtype=torch.float64))
+    total = field.band_covariance().sum(1)[0]
+    torch.testing.assert_close(torch.stack([vx[0], vy[0], cxy[0]]), total)
+    assert float(field.resolved_covariance(torch.tensor([math.inf], dtype=torch.float64))[0][0]) == 0.0
+
+
+# ------------------------------------------------------------------------------------------------
+# 3. Slopes are −∇η
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("dtype", DTYPES)
+def test_slope_is_minus_gradient_of_elevation(dtype):
+    """One octave on a fine tile (512 texels, highest mode θ = k·texel = 0.098): slope_x against a
+    central difference of the elevation at texel centres in x and on texel lines in y (and the other
+    way round for slope_y). The bilinear elevation is linear in x across a texel, so the difference
+    (step ¼ texel, divided by the realized step) is its exact derivative there; it and the interpolated
+    spectral slope agree to θ²/12 ≈ 0.1 % of the mode. Tolerance 0.5 % of the rms slope (2 % float32)."""
+    bands = WaveBands(k_edges=(1.0, 2.0), tile_size=512)
+    field = WaveField(8.0, 3, wind_direction=0.4, dtype=dtype, bands=bands)
+    h = bands.tile_length[0] / bands.tile_size
+    gen = torch.Generator().manual_seed(0)
+    i = torch.randint(0, 512, (1, 2000), generator=gen).double()
+    j = torch.randint(0, 512, (1, 2000), generator=gen).double()
+    step = 0.25 * h
+    tol = 0.005 if dtype == torch.float64 else 0.02
+
+    for axis in ("x", "y"):
+        x, y = ((i + 0.5) * h, j * h) if axis == "x" else (i * h, (j + 0.5) * h)
+        x, y = x.to(dtype), y.to(dtype)
+        s = field.sample(x, y, time_s=1.0)["slope_" + axis]
+        if axis == "x":
+            lo, hi = x - step, x + step
+            fd = -(field.sample(hi, y, 1.0)["elevation"] - field.sample(lo, y, 1.0)["elevation"]) / (hi - lo)
+        else:
+            lo, hi = y - step, y + step
+            fd = -(field.sample(x, hi, 1.0)["elevation"] - field.sample(x, lo, 1.0)["elevation"]) / (hi - lo)
+        rms = float(s.double().pow(2).mean().sqrt())
+        assert rms > 0
+        assert float((s - fd).abs().max()) < tol * rms, axis
+
+
+def test_slope_is_minus_gradient_default_layout():
+    """All 16 default bands at random points: the derivative of the bilinear interpolant differs from
+    the interpolated slope by O(θ) (θ ≤ 0.39 rad per texel); still 92 % of the rms, and −∇η, not +∇η."""
+    field = WaveField(10.0, 5, wind_direction=1.0, dtype=torch.float64)
+    gen = torch.Generator().manual_seed(2)
+    x = torch.rand(1, 4000, generator=gen, dtype=torch.float64) * 50
+    y = torch.rand(1, 4000, generator=gen, dtype=torch.float64) * 50
+    step = 1e-6
+    s = field.sample(x, y)
+    fdx = -(field.sample(x + step, y)["elevation"] - field.sample(x - step, y)["elevation"]) / (2 * step)
+    fdy = -(field.sample(x, y + step)["elevation"] - field.sample(x, y - step)["elevation"]) / (2 * step)
+    for a, b in ((s["slope_x"], fdx), (s["slope_y"], fdy)):
+        err = float((a - b).pow(2).mean().sqrt() / a.pow(2).mean().sqrt())
+        assert err < 0.08
+
+
+# ------------------------------------------------------------------------------------------------
+# 4. Waves move at their phase speed, downwind
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("k0", [0.5, K_M])
+def test_component_moves_at_phase_speed(k0):
+    """A band [k0, 1.01 k0) on a tile with Δk = k0/4 holds only the lattice modes (±4, 0), (0, ±4).
+    slope_x sees only the (4, 0) pair (∂/∂x of the y-modes is 0): a single plane wave along x.
+    With the downwind direction along +x (wind_direction = π is the upwind axis), slope_x(x + c t, t)
+    = slope_x(x, 0) for c = ω(k0)/k0, evaluated on texel nodes (no interpolation error), and not for
+    travel upwind. At k0 = k_m, c is the capillary minimum ≈ 0.23 m/s."""
+    bands = WaveBands(k_edges=(k0, 1.01 * k0), tile_size=128)
+    field = WaveField(10.0, 7, wind_direction=math.pi, dtype=torch.float64, bands=bands)
+    c = float(dispersion(torch.tensor(k0, dtype=torch.float64))) / k0
+    if k0 == K_M:
+        assert c == pytest.approx(0.23, abs=1e-3)
+    h = bands.tile_length[0] / bands.tile_size
+    shift = 5 * h  # 5 texels
+    t = shift / c
+    x = torch.arange(128, dtype=torch.float64)[None] * h
+    y = torch.full_like(x, 3 * h)
+    s0 = field.sample(x, y, 0.0)["slope_x"]
+    moved = field.sample(x + shift, y, t)["slope_x"]
+    scale = float(s0.abs().max())
+    assert scale > 0
+    torch.testing.assert_close(moved, s0, rtol=0, atol=1e-9 * scale)
+    assert float((field.sample(x, y, t)["slope_x"] - s0).abs().max()) > 0.5 * scale  # it did move
+    assert float((field.sample(x - shift, y, t)["slope_x"] - s0).abs().max()) > 0.5 * scale  # not upwind
+    wrong_speed = field.sample(x + shift, y, 1.1 * t)["slope_x"]
+    assert float((wrong_speed - s0).abs().max()) > 0.05 * scale
+
+
+# ------------------------------------------------------------------------------------------------
+# 5. Determinism
+# ------------------------------------------------------------------------------------------------
+def _check_batch_equals_alone(dtype: torch.dtype, npts: int, times: tuple[float, ...]) -> None:
+    seeds, winds, dirs = [11, 22, 33], [6.0, 12.0, 18.0], [0.3, 2.0, -1.0]
+    # per-image arguments as float64 tensors: the same numbers as the python floats used alone
+    batch = WaveField(
+        torch.tensor(winds, dtype=torch.float64), seeds, wind_direction=torch.tensor(dirs, dtype=torch.float64), dtype=dtype
+    )
+    gen = torch.Generator().manual_seed(4)
+    x = (torch.rand(3, npts, generator=gen, dtype=torch.float64) * 300 - 100).to(dtype)
+    y = (torch.rand(3, npts, generator=gen, dtype=torch.float64) * 300 - 100).to(dtype)
+    fp = (10 ** (torch.rand(3, npts, generator=gen, dtype=torch.float64) * 4 - 3)).to(dtype)
+    alone = [WaveField(winds[i], seeds[i], wind_direction=dirs[i], dtype=dtype) for i in range(3)]
+    for t in times:
+        together = batch.sample(x, y, time_s=t, footprint=fp)
+        for i in range(3):
+            single = alone[i].sample(x[i : i + 1], y[i : i + 1], time_s=t, footprint=fp[i : i + 1])
+            for key in ("elevation", "slope_x", "slope_y"):
+                assert torch.equal(together[key][i : i + 1], single[key]), (key, i, t)
+    for i in range(3):
+        assert torch.equal(batch.band_covariance()[i], alone[i].band_covariance()[0])
+
+
+@pytest.mark.parametrize("dtype", DTYPES)
+def test_batch_member_equals_image_alone_bitwise(dtype, monkeypatch):
+    """Image i of a batch of 3 is bitwise the same (seed, wind, direction) rendered alone, at two
+    times, with footprints; small chunks (1365 points per chunk in the batch, 4096 alone) so that the
+    chunk boundaries differ between the two."""
+    monkeypatch.setattr(waves, "_CHUNK_ELEMENTS", 2**12)
+    _check_batch_equals_alone(dtype, 6000, (0.0, 7.25))
+
+
+def test_batch_member_equals_image_alone_bitwise_two_threads(monkeypatch):
+    """Same on 2 threads, with tensors large enough for intra-op parallel splits: 40 000 points per
+    image, chunks of 21 845 points in the batch (2**16 elements / 3), one chunk alone."""
+    monkeypatch.setattr(waves, "_CHUNK_ELEMENTS", 2**16)
+    n = torch.get_num_threads()
+    torch.set_num_threads(2)
+    try:
+        _check_batch_equals_alone(torch.float32, 40_000, (3.5,))
+    finally:
+        torch.set_num_threads(n)
+
+
+@pytest.mark.parametrize("extent, tol", [(1.0, 5e-5), (30.0, 1e-3)])
+def test_float32_agrees_with_float64(extent, tol):
+    """Same realization in both dtypes (draws float64 on the CPU, spectrum and phases float64, then
+    cast): the tiles agree to ~2e-7; what remains is float32 rounding of the tile coordinate x·2/L_o,
+    which grows with |x|/L_o (L = 0.196 m for the shortest band): ~1e-4 of the rms at |x| ≤ 30 m."""
+    gen = torch.Generator().manual_seed(5)
+    x = (torch.rand(2, 3000, generator=gen) * 2 - 1) * extent  # float32-representable coordinates
+    y = (torch.rand(2, 3000, generator=gen) * 2 - 1) * extent
+    kw = dict(wind_direction=torch.tensor([0.2, 1.3], dtype=torch.float64))
+    wind = torch.tensor([7.0, 14.0], dtype=torch.float64)
+    f32 = WaveField(wind, [1, 2], dtype=torch.float32, **kw).sample(x, y, 2.0)
+    f64 = WaveField(wind, [1, 2], dtype=torch.float64, **kw).sample(x.double(), y.double(), 2.0)
+    for key in f32:
+        assert f32[key].dtype == torch.float32 and f64[key].dtype == torch.float64
+        rms = float(f64[key].pow(2).mean().sqrt())
+        assert float((f32[key].double() - f64[key]).abs().max()) < tol * rms, key
+
+
+def test_seed_changes_realization_and_int_seed_equals_list():
+    a = WaveField(9.0, 1, dtype=torch.float64)
+    b = WaveField(9.0, [1], dtype=torch.float64)
+    c = WaveField(9.0, torch.tensor([2]), dtype=torch.float64)
+    x = torch.linspace(0, 30, 500, dtype=torch.float64)[None]
+    assert torch.equal(a.sample(x, x)["slope_x"], b.sample(x, x)["slope_x"])
+    assert not torch.allclose(a.sample(x, x)["slope_x"], c.sample(x, x)["slope_x"])
+
+
+# ------------------------------------------------------------------------------------------------
+# 6. Gradients
+# ------------------------------------------------------------------------------------------------
+def test_gradient_wrt_wind_speed_matches_central_difference():
+    """d(mean square slope of the sample)/dU10 by autograd equals a float64 central difference
+    (the random draws are fixed; the amplitudes √(F Δk²) are smooth in U10 at 10 m/s)."""
+    gen = torch.Generator().manual_seed(6)
+    x = torch.rand(2, 2000, generator=gen, dtype=torch.float64) * 100
+    y = torch.rand(2, 2000, generator=gen, dtype=torch.float64) * 100
+    fp = torch.full_like(x, 0.03)
+
+    def mss(u: torch.Tensor) -> torch.Tensor:
+        out = WaveField(u, [3, 4], wind_direction=0.5, dtype=torch.float64).sample(x, y, 1.0, footprint=fp)
+        return (out["slope_x"] ** 2 + out["slope_y"] ** 2).mean()
+
+    u = torch.tensor([10.0, 13.0], dtype=torch.float64, requires_grad=True)
+    (grad,) = torch.autograd.grad(mss(u), u)
+    assert bool(torch.isfinite(grad).all()) and bool((grad > 0).all())
+    eps = 1e-4
+    for i in range(2):
+        du = torch.zeros(2, dtype=torch.float64)
+        du[i] = eps
+        fd = (mss(u.detach() + du) - mss(u.detach() - du)) / (2 * eps)
+        assert float(grad[i]) == pytest.approx(float(fd), rel=1e-5)
+
+
+@pytest.mark.parametrize("dtype", DTYPES)
+def test_gradients_wrt_points_and_footprint_are_finite(dtype):
+    gen = torch.Generator().manual_seed(7)
+    x = (torch.rand(1, 500, generator=gen) * 40).to(dtype).requires_grad_()
+    y = (torch.rand(1, 500, generator=gen) * 40).to(dtype).requires_grad_()
+    fp = torch.cat([torch.full((1, 250), 0.02), torch.full((1, 250), math.inf)], 1).to(dtype).requires_grad_()
+    wind = torch.tensor(9.0, dtype=dtype, requires_grad=True)
+    out = WaveField(wind, 8, dtype=dtype).sample(x, y, 0.5, footprint=fp)
+    (out["slope_x"].sum() + out["slope_y"].sum() + out["elevation"].sum()).backward()
+    for t in (x, y, fp, wind):
+        assert bool(torch.isfinite(t.grad).all())
+    assert float(x.grad.abs().sum()) > 0 and float(wind.grad.abs()) > 0
+    assert bool((out["slope_x"][:, 250:] == 0).all())  # infinite footprint: nothing resolved
+
+
+# ------------------------------------------------------------------------------------------------
+# 7. Errors
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(wind_speed=0.0, seed=0), "wind_speed.*expectation"),
+        (dict(wind_speed=-3.0, seed=0), r"wind_speed must lie in \(0, 80\]"),
+        (dict(wind_speed=81.0, seed=0), r"wind_speed must lie in \(0, 80\]"),
+        (dict(wind_speed=float("nan"), seed=0), "wind_speed"),
+        (dict(wind_speed=torch.tensor([5.0, 6.0]), seed=0), "seed: an int seed"),
+        (dict(wind_speed=torch.tensor([5.0, 6.0]), seed=[1, 2, 3]), r"seed, wind_speed.*batch sizes differ \(seed has 3, wind_speed has 2\)"),
+        (dict(wind_speed=5.0, seed=-1), r"seed: each seed must lie in \[0, 2\*\*63\)"),
+        (dict(wind_speed=5.0, seed=1.5), "seed must be an int"),
+        (dict(wind_speed=5.0, seed=0, inverse_wave_age=0.5), r"inverse_wave_age must lie in \[0.84, 5\]"),
+        (dict(wind_speed=5.0, seed=0, wind_direction=float("nan")), "wind_direction"),
+        (dict(wind_speed=5.0, seed=0, dtype=torch.float16), "dtype"),
+    ],
+)
+def test_constructor_errors(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        WaveField(**kwargs)
+
+
+def test_sample_and_spectrum_errors():
+    field = WaveField(5.0, 0)
+    x = torch.zeros(1, 4)
+    with pytest.raises(ValueError, match=r"footprint must lie in \[0, inf\]"):
+        field.sample(x, x, footprint=torch.tensor([[0.1, -0.1, 0.1, 0.1]]))
+    with pytest.raises(ValueError, match=r"footprint must lie in \[0, inf\]"):
+        field.sample(x, x, footprint=torch.tensor([[0.1, float("nan"), 0.1, 0.1]]))
+    with pytest.raises(ValueError, match=r"footprint must lie in \[0, inf\]"):
+        field.resolved_covariance(torch.tensor([-1.0]))
+    with pytest.raises(ValueError, match="x must be finite"):
+        field.sample(torch.tensor([[0.0, float("nan"), 0.0, 0.0]]), x)
+    with pytest.raises(ValueError, match=r"x, y: must have shape \(B, \.\.\.\) with B = 1"):
+        field.sample(torch.zeros(2, 4), torch.zeros(2, 4))
+    with pytest.raises(ValueError, match="time_s"):
+        field.sample(x, x, time_s=float("nan"))
+    with pytest.raises(ValueError, match=r"k must lie in \(0, inf\]"):
+        elfouhaily_spectrum(0.0, 0.0, 10.0)
+    with pytest.raises(ValueError, match="phi"):
+        elfouhaily_spectrum(1.0, float("nan"), 10.0)
+    with pytest.raises(ValueError, match="wind_speed"):
+        elfouhaily_omnidirectional(1.0, 0.0)
+    with pytest.raises(ValueError, match="k_edges must be strictly increasing"):
+        WaveBands(k_edges=(1.0, 0.5))
+    with pytest.raises(ValueError, match="tile_size/4"):
+        WaveBands(k_edges=(1.0, 2.0), tile_size=16)
+
+
+# ------------------------------------------------------------------------------------------------
+# 8. CUDA
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.skipif(not torch.cuda.is_available(), reason="needs a CUDA device")
+def test_cuda_realization_equals_cpu():
+    gen = torch.Generator().manual_seed(9)
+    x = torch.rand(2, 5000, generator=gen, dtype=torch.float64) * 100
+    y = torch.rand(2, 5000, generator=gen, dtype=torch.float64) * 100
+    fp = torch.full_like(x, 0.05)
+    kw = dict(wind_direction=torch.tensor([0.1, 2.0], dtype=torch.float64), dtype=torch.float64)
+    cpu = WaveField(torch.tensor([8.0, 16.0], dtype=torch.float64), [5, 6], **kw).sample(x, y, 1.5, footprint=fp)
+    cuda = WaveField(torch.tensor([8.0, 16.0], dtype=torch.float64, device="cuda"), [5, 6], device="cuda", **kw).sample(
+        x.cuda(), y.cuda(), 1.5, footprint=fp.cuda()
+    )
+    for key in cpu:
+        assert cuda[key].device.type == "cuda"
+        torch.testing.assert_close(cuda[key].cpu(), cpu[key], rtol=0, atol=1e-9 * float(cpu[key].abs().max()))
