@@ -1,7 +1,9 @@
 """The main job: render a batch of infrared sea backgrounds on the built-in default scene.
 
 Eight 512×640 LWIR (8–12 µm) images, each with its own wind, wind direction, sea temperature and
-camera pose, under the shipped LOWTRAN7 midlatitude-summer sky. Writes to ``--out``:
+camera pose, under the shipped LOWTRAN7 midlatitude-summer sky, each a textured sea realization
+(wave clutter; ``--no-texture`` renders the expectation images, the mean over the slope
+statistics). Writes to ``--out``:
 
 - ``grid_brightness_temperature.png``: the batch as a picture grid (brightness temperature, K);
 - ``image_XX.png``: each image as a 16-bit grayscale PNG, linear in brightness temperature between
@@ -47,6 +49,8 @@ def main() -> None:
     ap.add_argument("--hfov", type=float, default=30.0, help="horizontal field of view [deg]")
     ap.add_argument("--sky", default="midlatitude_summer", help="shipped atmosphere name, or a constant radiance")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--texture", action=argparse.BooleanOptionalAction, default=True,
+                    help="textured sea realizations (default) or expectation images (--no-texture)")
     args = ap.parse_args()
 
     p = default_batch(args.batch, args.seed)
@@ -56,8 +60,9 @@ def main() -> None:
         sky = float(args.sky)  # a constant sky radiance [W m-2 sr-1]
     except ValueError:
         sky = args.sky  # a shipped atmosphere
+    wave_seeds = [1000 * args.seed + i for i in range(args.batch)] if args.texture else None
     scene = rs.SeaScene(wind_speed=p["wind_speed"], wind_direction=p["wind_direction"],
-                        sea_temperature=p["sea_temperature"], sky=sky)
+                        sea_temperature=p["sea_temperature"], sky=sky, seed=wave_seeds)
     t0 = time.perf_counter()
     bt = rs.render(cams, scene, output="brightness_temperature")
     dt = time.perf_counter() - t0
@@ -75,7 +80,8 @@ def main() -> None:
             "render_seconds": dt, "images": []}
     for i in range(args.batch):
         save_png16(bt[i, 0], args.out / f"image_{i:02d}.png", lo, hi)
-        meta["images"].append({k: float(v[i]) for k, v in p.items()} | {"file": f"image_{i:02d}.png"})
+        meta["images"].append({k: float(v[i]) for k, v in p.items()} | {"file": f"image_{i:02d}.png"}
+                              | ({"wave_seed": wave_seeds[i], "time_s": 0.0} if wave_seeds else {}))
     (args.out / "metadata.json").write_text(json.dumps(meta, indent=2))
     print(f"wrote {args.out}/grid_brightness_temperature.png, {args.batch} 16-bit PNGs and metadata.json")
 

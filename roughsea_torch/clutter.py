@@ -315,7 +315,7 @@ class TextureTable:
     def pixels(self, sl: slice, p: dict, wf: Any, vol: torch.Tensor, cos_t: torch.Tensor,
                zeta: torch.Tensor, o: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, sea: torch.Tensor,
                lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, altitude: torch.Tensor,
-               earth_radius_m: float) -> torch.Tensor:
+               earth_radius_m: float, eps: torch.Tensor) -> torch.Tensor:
         """The texture of every pixel of images ``sl`` (0 off the sea), (b, H, W)."""
         import torch.nn.functional as F
 
@@ -329,10 +329,20 @@ class TextureTable:
         X = cen[:, 0, None, None] + R * dx
         Y = cen[:, 1, None, None] + R * dy
         smp = wf.sample(X, Y, self.time[sl], footprint=L, elevation=False)
-        cov, lam = self.resolved(wf, L, p, sl)
-        x, _, _ = pixel_resolved_slope(lam * smp["slope_x"], lam * smp["slope_y"], cov, dx, dy)
-        gz = x / (self.width * (1.0 + self.ex))
         gy = (2.0 * (zeta - lo.to(dtype)[:, None, None]) / span_z.to(dtype)[:, None, None] - 1.0) / (1.0 + self.ez)
+        # σ_a of each pixel from the resolved covariance of its row: for one camera the footprint is a
+        # function of θ̂ alone, so the covariance is tabulated on the texture's rows and read
+        # linearly in ζ (one 3-channel lookup instead of the 16 band windows per pixel); the
+        # reconciling scale λ cancels in x = λ a / (λ σ_a)
+        rows = (lo[:, None] + span_z[:, None] * (torch.linspace(-1.0 - self.ez, 1.0 + self.ez, self.Lz.shape[0],
+                dtype=torch.float64, device=lo.device) + 1) / 2)
+        cos_r = (eps[:, None] * torch.sinh(rows)).clamp(1e-9, 1.0).to(dtype)
+        L_r = footprint(_slant_range(cos_r, h[:, :, 0], earth_radius_m), cos_r, self.ifov[sl, None])
+        cov_rows = torch.stack(wf.resolved_covariance(L_r), 1)[..., None]  # (b, 3, rows, 1)
+        grid = torch.stack([torch.zeros_like(gy), gy], -1)
+        cov = F.grid_sample(cov_rows, grid, mode="bilinear", padding_mode="border", align_corners=True)
+        x, _, _ = pixel_resolved_slope(smp["slope_x"], smp["slope_y"], (cov[:, 0], cov[:, 1], cov[:, 2]), dx, dy)
+        gz = x / (self.width * (1.0 + self.ex))
         a_, b2 = a.to(dtype)[:, None, None], b.to(dtype)[:, None, None]
         gx = (2.0 * (o - a_) / (b2 - a_) - 1.0) / (1.0 + self.ea)
         grid = torch.stack([gx, gy, gz], -1)[:, None]  # (b, 1, H, W, 3): x → W (azimuth), y → H (ζ), z → D (x)

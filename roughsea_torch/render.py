@@ -930,7 +930,7 @@ def _render_table(
             cos_t = eps[sl, None, None].to(dtype) * torch.sqrt(q_)
             o = _azimuth_coordinate(dx, dy, offset, fold)
             vals = vals + tex.pixels(sl, p, wf, delta, cos_t, zeta, o, dx, dy, sea, lo, span_z, a, b, altitude,
-                                     earth_radius_m)
+                                     earth_radius_m, eps[sl])
         if textured and brightness:  # per pixel: the texture is added in radiance
             vals = _kelvin(vals, scene.band)
         return vals
