@@ -33,6 +33,33 @@ ladder alpha +- w 8^j around the major axis alpha (w = sqrt(l_min/l_max), the an
 the phi-marginal of the density).
 A second, independent ordering ("theta_outer": theta outside, phi inside with the edges solved for
 phi) is provided for cross-checks.
+
+Shifted slope law (keyword slope_mean = (mean_upwind, mean_crosswind), default (0, 0)):
+the slopes s = (s_x, s_y) = tan(theta) (cos phi, sin phi) are N(s; mu, Sigma) instead of N(s; 0, Sigma).
+This is the two-scale model of docs/waves.md sec. 2: a resolved tilt mu (in the upwind/crosswind
+frame) carries unresolved slopes of covariance Sigma; everything else is the paper's model as it
+stands: the sky and theta' stay in the world frame, the weight is Eq. 5 (Eq. 4 without H).
+mu uses the convention of s: the facet of slope mu has the normal (mu_x, mu_y, 1)/sqrt(1 + |mu|^2),
+i.e. it leans towards mu (physics.md sec. 2; waves.md sec. 4: s = -grad(eta), the negative height
+gradient; the paper's A5 writes +grad h, which for zero mean is the same law).
+  * Density: p_mu(theta, phi) = N(tan(theta) (cos phi, sin phi); mu, Sigma) tan(theta) sec^2(theta),
+    the Jacobian of Eq. A6/A7 (s = t (cos phi, sin phi) are polar coordinates in slope space,
+    ds = t dt dphi, dt = sec^2(theta) dtheta). mu = 0 is Eq. A7/A8.
+  * Normalization: D of Eq. 5 by quadrature as before; without shadowing the Eq. 4 denominator is
+    int N(s; mu, Sigma) (cos th + sin th s_par) ds = cos th + sin th (mu . (cos ph, sin ph)), used in
+    closed form (Eq. 7's cos th relied on p(theta, phi) = p(theta, phi + pi), which a mean breaks).
+  * Support and breakpoints. The density is no longer centred on theta = 0, so the N_RMS cut is
+    taken along each ray s = t (cos phi, sin phi): there the exponent is a Gaussian in t of centre
+    t0 = B/Q, rms 1/sqrt(Q) (Q = u^T Sigma^-1 u, B = u^T Sigma^-1 mu), so theta runs over
+    atan(t0 -+ N_RMS/sqrt(Q)) (clipped at 0) with a breakpoint at the peak atan(t0); rays that never
+    come within N_RMS (Mahalanobis) of mu are empty. The outer phi integral keeps the breakpoints
+    above and adds the mean azimuth alpha_mu = atan2(mu_y, mu_x) with a ladder alpha_mu +- w 8^j,
+    w = sqrt(l_min)/|mu|: a mean |mu| >> rms makes the phi-marginal a peak of width ~rms/|mu| there.
+    The theta_outer ordering uses |s| in |mu| -+ N_RMS sqrt(l_max), breakpoints at |s| = |mu| with a
+    ladder, and, on each ring |s| = t, the azimuths where the ring meets the major axis through mu.
+  * mu = (0, 0) (also -0.0) runs exactly the unshifted code above; results are unchanged bit for bit.
+  * Flat sea (a = b = 0) with a mean: one facet of slope mu, in closed form. A mean with exactly one
+    rms slope 0 (a line law off the origin) is not supported (NotImplementedError).
 """
 
 import math
@@ -105,10 +132,13 @@ class _FacetIntegral:
           "emis"  integrand p cos(Omega)/cos(theta) [H] (1 - rho(|cos Omega|))
           "rad"   integrand p cos(Omega)/cos(theta) [H] {(1 - rho) R_B + rho R_s(theta')} (Eq. 10)
     The integrals returned are NOT normalized (divide by D, see the public functions).
+    mean = (mean_upwind, mean_crosswind): mean of the slope Gaussian. (0, 0) is the paper's law and
+    runs the unshifted code unchanged; otherwise the shifted density and its support/breakpoints are
+    used (see the module docstring).
     """
 
     def __init__(self, theta_hat, phi_hat, a, b, r, shadowing, kind,
-                 m=None, sea_radiance=None, sky=None):
+                 m=None, sea_radiance=None, sky=None, mean=(0.0, 0.0)):
         self.th = float(theta_hat)
         self.ph = float(phi_hat)
         self.ct = math.cos(self.th)
@@ -126,10 +156,28 @@ class _FacetIntegral:
             self.line = (self.a, (0.0, math.pi))           # s_y = 0: phi = 0 or pi
         else:
             self.line = (self.b, (HALF_PI, 1.5 * math.pi))  # s_x = 0: phi = pi/2 or 3pi/2
+        self.mx, self.my = float(mean[0]), float(mean[1])
+        self.shifted = self.mx != 0.0 or self.my != 0.0
+        if self.shifted:
+            if self.line is not None:
+                raise NotImplementedError("a non-zero slope_mean needs both rms slopes > 0")
+            # inverse covariance Sigma^-1 = [[ixx, ixy], [ixy, iyy]] and the eigenvalues of Sigma
+            one_r2 = 1.0 - self.r * self.r
+            self.ixx = 1.0 / (self.a * self.a * one_r2)
+            self.iyy = 1.0 / (self.b * self.b * one_r2)
+            self.ixy = -self.r / (self.a * self.b * one_r2)
+            self.mean_maha2 = (self.ixx * self.mx * self.mx + 2.0 * self.ixy * self.mx * self.my
+                               + self.iyy * self.my * self.my)  # mu^T Sigma^-1 mu
+            tr = self.a * self.a + self.b * self.b
+            det = self.a * self.a * self.b * self.b * one_r2
+            self.lam1 = 0.5 * tr + math.sqrt(max(0.25 * tr * tr - det, 0.0))
+            self.lam2 = det / self.lam1
 
     # --- model pieces --------------------------------------------------------------------------
     def density(self, theta, phi):
         """p(theta, phi), Eq. A7/A8; for a degenerate (line) law the density along the line."""
+        if self.shifted:
+            return _pdf_shifted_scalar(theta, phi, self.a, self.b, self.r, self.mx, self.my)
         if self.line is None:
             return _pdf_scalar(theta, phi, self.a, self.b, self.r)
         sig = self.line[0]
@@ -202,19 +250,80 @@ class _FacetIntegral:
             w *= 8.0
         return pts
 
+    def ray_support(self, phi):
+        """Shifted law: (theta_lo, theta_hi, peaks) of the density along the ray s = t (cos phi, sin phi).
+
+        On the ray the exponent (s - mu)^T Sigma^-1 (s - mu) = Q t^2 - 2 B t + mu^T Sigma^-1 mu,
+        Q = u^T Sigma^-1 u (= E(phi, r)/(1 - r^2), Eq. A8), B = u^T Sigma^-1 mu, u = (cos phi, sin phi):
+        a Gaussian in t of centre t0 = B/Q and rms 1/sqrt(Q). The support is t0 -+ N_RMS/sqrt(Q),
+        clipped to t >= 0; it is empty when the ray stays more than N_RMS (Mahalanobis) from mu.
+        peaks: [atan(t0)] when t0 > 0 (a breakpoint, so quad cannot step over the peak).
+        """
+        c, s = math.cos(phi), math.sin(phi)
+        q = self.ixx * c * c + 2.0 * self.ixy * c * s + self.iyy * s * s
+        b = self.ixx * c * self.mx + self.ixy * (c * self.my + s * self.mx) + self.iyy * s * self.my
+        t0 = b / q
+        closest2 = self.mean_maha2 - (b * t0 if t0 > 0.0 else 0.0)  # min over t >= 0 of the exponent
+        half = N_RMS / math.sqrt(q)
+        if closest2 > N_RMS * N_RMS or t0 + half <= 0.0:
+            return 0.0, 0.0, []
+        return math.atan(max(t0 - half, 0.0)), math.atan(t0 + half), ([math.atan(t0)] if t0 > 0.0 else [])
+
+    def mean_azimuths(self):
+        """Shifted law: azimuth breakpoints around the azimuth alpha_mu of the mean slope.
+
+        Seen from s = 0 a mean |mu| >> rms makes the phi-marginal a peak at alpha_mu of angular
+        half-width ~ rms/|mu|: breakpoints at alpha_mu and alpha_mu +- w 8^j, w = sqrt(l_min)/|mu|,
+        up to pi/4 (the same ladder idea as principal_azimuths). Empty for the unshifted law.
+        """
+        if not self.shifted:
+            return []
+        alpha = math.atan2(self.my, self.mx)
+        pts = [alpha]
+        w = math.sqrt(self.lam2) / math.hypot(self.mx, self.my)
+        while w < 0.25 * math.pi:
+            pts.extend([alpha - w, alpha + w])
+            w *= 8.0
+        return pts
+
+    def ring_azimuths(self, theta):
+        """Shifted law, theta-outer ordering: azimuth breakpoints on the ring |s| = t = tan(theta).
+
+        A thin law has its mass along its major axis through mu, the line mu + l e1. The ring meets
+        it where l^2 + 2 l (mu . e1) + |mu|^2 - t^2 = 0; breakpoints there, with a ladder of angular
+        half-widths sqrt(l_min)/t 8^j up to pi/4, and at the azimuth of the line's point nearest s = 0.
+        """
+        t = math.tan(theta)
+        alpha = 0.5 * math.atan2(2.0 * self.r * self.a * self.b, self.a * self.a - self.b * self.b)
+        ex, ey = math.cos(alpha), math.sin(alpha)  # major axis e1
+        proj = self.mx * ex + self.my * ey
+        pts = [math.atan2(self.my - proj * ey, self.mx - proj * ex)]
+        disc = proj * proj - (self.mx * self.mx + self.my * self.my) + t * t
+        if disc >= 0.0 and t > 0.0:
+            for lam in (-proj - math.sqrt(disc), -proj + math.sqrt(disc)):
+                phi0 = math.atan2(self.my + lam * ey, self.mx + lam * ex)
+                pts.append(phi0)
+                w = math.sqrt(self.lam2) / t
+                while w < 0.25 * math.pi:
+                    pts.extend([phi0 - w, phi0 + w])
+                    w *= 8.0
+        return pts
+
     # --- phi outer, theta inner ----------------------------------------------------------------
     def theta_edges(self, phi):
-        """Closed-form theta breakpoints (sorted, with 0 and the upper limit) for azimuth phi."""
+        """Closed-form theta breakpoints (sorted, with the lower and upper limits) for azimuth phi."""
         c = math.cos(phi - self.ph)
         delta = math.atan2(self.st * c, self.ct)
         theta_shadow = HALF_PI + delta   # cos(Omega) = 0, Eq. 6
         theta_sky = 0.5 * theta_shadow   # cos(theta') = 0, Eq. 9
-        upper = self.theta_max(phi)
+        if self.shifted:
+            lower, upper, cuts = self.ray_support(phi)
+        else:
+            lower, upper, cuts = 0.0, self.theta_max(phi), []
         if self.shadowing:
             upper = min(upper, theta_shadow)
-        if upper <= 0.0:
-            return [0.0]
-        cuts = []
+        if upper <= lower:
+            return [lower]
         if not self.shadowing:
             cuts.append(theta_shadow)
         if self.kind == "rad":
@@ -226,8 +335,8 @@ class _FacetIntegral:
                     if abs(x) <= 1.0:
                         g = math.acos(x)
                         cuts.extend([0.5 * (delta + g), 0.5 * (delta - g)])
-        inner = sorted(x for x in cuts if 0.0 < x < upper)
-        return [0.0] + inner + [upper]
+        inner = sorted(x for x in cuts if lower < x < upper)
+        return [lower] + inner + [upper]
 
     def theta_integral(self, phi, epsrel):
         edges = self.theta_edges(phi)
@@ -240,14 +349,14 @@ class _FacetIntegral:
                                         epsabs=0.0, epsrel=epsrel, limit=200)[0]
         return total
 
-    def phi_outer(self, epsrel):
+    def phi_outer(self, epsrel, epsabs=0.0):
         inner_eps = max(1e-2 * epsrel, 1e-13)
         if self.line is not None:
             return sum(self.theta_integral(phi0, inner_eps) for phi0 in self.line[1])
         pts = [self.ph + k * HALF_PI for k in range(4)] + self.principal_azimuths()
-        pts = _unique_mod_2pi(pts)
+        pts = _unique_mod_2pi(pts + self.mean_azimuths())
         return integrate.quad(self.theta_integral, 0.0, TWO_PI, args=(inner_eps,),
-                              points=pts, epsabs=0.0, epsrel=epsrel, limit=1000)[0]
+                              points=pts, epsabs=epsabs, epsrel=epsrel, limit=1000)[0]
 
     # --- theta outer, phi inner (independent ordering, for cross-checks) --------------------------
     def phi_edges(self, theta):
@@ -261,45 +370,90 @@ class _FacetIntegral:
                     for z in self.sky.nodes:
                         cs.append((math.cos(z) - cos2 * self.ct) / (sin2 * self.st))
         pts = [self.ph + k * HALF_PI for k in range(4)] + self.principal_azimuths()
+        if self.shifted:
+            pts += self.mean_azimuths() + self.ring_azimuths(theta)
         for c in cs:
             if -1.0 <= c <= 1.0:
                 g = math.acos(c)
                 pts.extend([self.ph + g, self.ph - g])
         return _unique_mod_2pi(pts)
 
-    def phi_integral(self, theta, epsrel):
+    def phi_integral(self, theta, epsrel, epsabs=0.0):
         return integrate.quad(lambda phi: self.integrand(theta, phi), 0.0, TWO_PI,
-                              points=self.phi_edges(theta), epsabs=0.0, epsrel=epsrel,
+                              points=self.phi_edges(theta), epsabs=epsabs, epsrel=epsrel,
                               limit=1000)[0]
 
-    def theta_outer(self, epsrel):
+    def theta_outer(self, epsrel, epsabs=0.0):
         inner_eps = max(1e-2 * epsrel, 1e-13)
         if self.line is not None:
             return self.phi_outer(epsrel)
-        upper = self.theta_max_global()
+        lower, upper = 0.0, self.theta_max_global()
         pts = [HALF_PI - self.th]
         if self.kind == "rad":
             pts += [0.5 * (HALF_PI - self.th), 0.5 * (HALF_PI + self.th)]
             if self.sky.nodes is not None:
                 for z in self.sky.nodes:
                     pts += [0.5 * (z + self.th), 0.5 * (z - self.th), 0.5 * (self.th - z)]
+        axes = self.principal_azimuths()[:4]
+        if self.shifted:
+            # |s| of the N_RMS ellipse around mu lies within |mu| -+ N_RMS sqrt(l_max); breakpoints at
+            # |s| = |mu| and a ladder |mu| +- sqrt(l_min) 8^j, and the edges along the mean azimuth
+            norm = math.hypot(self.mx, self.my)
+            reach = N_RMS * math.sqrt(self.lam1)
+            lower, upper = math.atan(max(norm - reach, 0.0)), math.atan(norm + reach)
+            pts.append(math.atan(norm))
+            w = math.sqrt(self.lam2)
+            while w < reach:
+                pts.extend([math.atan(max(norm - w, 0.0)), math.atan(norm + w)])
+                w *= 8.0
+            axes = axes + [math.atan2(self.my, self.mx)]
         # theta where the shadow / sky edges cross the principal axes (where the mass is when a/b >> 1)
-        for beta in self.principal_azimuths()[:4]:
+        for beta in axes:
             c = math.cos(beta - self.ph)
             theta_shadow = HALF_PI + math.atan2(self.st * c, self.ct)
             pts.append(theta_shadow)
             if self.kind == "rad":
                 pts.append(0.5 * theta_shadow)
-        pts = sorted(x for x in pts if 0.0 < x < upper)
-        return integrate.quad(self.phi_integral, 0.0, upper, args=(inner_eps,),
-                              points=pts or None, epsabs=0.0, epsrel=epsrel, limit=1000)[0]
+        pts = sorted(x for x in pts if lower < x < upper)
+        if self.shifted:  # the mean azimuth can repeat an axis: drop near-duplicates (they upset quad)
+            pts = [x for i, x in enumerate(pts) if i == 0 or x - pts[i - 1] > 1e-13]
+        # shifted: the theta range is a bound (a circle around mu), and on its rims the ring integral can be
+        # subnormal (~1e-316), where quad reports roundoff; an absolute floor of 1e-200 ends that
+        inner_abs = max(10.0 * epsabs, 1e-200) if self.shifted else 0.0
+        return integrate.quad(self.phi_integral, lower, upper, args=(inner_eps, inner_abs),
+                              points=pts or None, epsabs=epsabs, epsrel=epsrel, limit=1000)[0]
 
-    def integral(self, epsrel, method):
+    def integral(self, epsrel, method, epsabs=0.0):
         if method == "phi_outer":
-            return self.phi_outer(epsrel)
+            return self.phi_outer(epsrel, epsabs)
         if method == "theta_outer":
-            return self.theta_outer(epsrel)
+            return self.theta_outer(epsrel, epsabs)
         raise ValueError("method must be 'phi_outer' or 'theta_outer'")
+
+
+def _pdf_shifted_scalar(theta, phi, a, b, r, mx, my):
+    """Density of facet normals (per rad^2) when the slopes are N(s; mu, Sigma), mu = (mx, my) != 0.
+
+    Same change of variables as Eq. A5-A7: s = tan(theta) (cos phi, sin phi) with the facet normal
+    n = (s_x, s_y, 1)/sqrt(1 + |s|^2) (polar angle theta, azimuth phi). In the slope plane these are
+    polar coordinates of radius t = tan(theta): ds_x ds_y = t dt dphi = tan(theta) sec^2(theta) dtheta dphi.
+    Hence
+      p_mu(theta, phi) = sec^2(theta) tan(theta) / (2 pi a b sqrt(1 - r^2))
+                         * exp(-[dx^2/a^2 - 2 r dx dy/(a b) + dy^2/b^2] / (2 (1 - r^2))),
+      dx = tan(theta) cos(phi) - mx,  dy = tan(theta) sin(phi) - my,
+    i.e. N(s; mu, Sigma) tan(theta) sec^2(theta); mu = 0 is Eq. A7/A8. Needs a, b > 0, |r| < 1;
+    0 outside theta in [0, pi/2).
+    """
+    if not (0.0 <= theta < 0.5 * math.pi):
+        return 0.0
+    t = math.tan(theta)
+    dx = t * math.cos(phi) - mx
+    dy = t * math.sin(phi) - my
+    one_r2 = 1.0 - r * r
+    maha2 = (dx * dx / (a * a) - 2.0 * r * dx * dy / (a * b) + dy * dy / (b * b)) / one_r2
+    cos_t = math.cos(theta)
+    return (t / (cos_t * cos_t) / (2.0 * math.pi * a * b * math.sqrt(one_r2))
+            * math.exp(-0.5 * maha2))
 
 
 def _unique_mod_2pi(values):
@@ -327,30 +481,87 @@ def _slope_arrays(slopes):
     return _check_slope_arrays(slopes.std_upwind, slopes.std_crosswind, slopes.corr)
 
 
+def _check_slope_mean(slope_mean):
+    """slope_mean = (mean_upwind, mean_crosswind): two finite floats or arrays -> two float64 arrays."""
+    try:
+        mx, my = slope_mean
+    except (TypeError, ValueError):
+        raise ValueError("slope_mean must be a pair (mean_upwind, mean_crosswind)") from None
+    mx = np.asarray(mx, dtype=np.float64)
+    my = np.asarray(my, dtype=np.float64)
+    if not (np.all(np.isfinite(mx)) and np.all(np.isfinite(my))):
+        raise ValueError("slope_mean must be finite")
+    return mx, my
+
+
+def _is_shifted(mean):
+    return mean[0] != 0.0 or mean[1] != 0.0
+
+
+def _mean_facet_weight(th, ph, mean):
+    """cos(Omega)/cos(theta) of the facet of slope mu: cos th + sin th (mu . (cos ph, sin ph)).
+
+    physics.md sec. 3 (linear in s). It is also the exact Eq. 4 denominator
+    int N(s; mu, Sigma) (cos th + sin th s_par) ds for any Sigma (no shadowing).
+    """
+    return math.cos(th) + math.sin(th) * (mean[0] * math.cos(ph) + mean[1] * math.sin(ph))
+
+
+def _tilted_flat_facet(th, ph, mean):
+    """Flat sea tilted to the slope mu (a = b = 0, mu != 0): one facet, normal (mx, my, 1)/sqrt(1+|mu|^2).
+
+    Returns (w, cos_omega, cos_theta_r): w = cos(Omega)/cos(theta), cos(Omega) (Eq. 6 in slope form),
+    cos(theta') = 2 cos(Omega) cos(theta) - cos(th) (Eq. 9).
+    """
+    w = _mean_facet_weight(th, ph, mean)
+    cos_theta = 1.0 / math.sqrt(1.0 + mean[0] * mean[0] + mean[1] * mean[1])
+    cos_omega = w * cos_theta
+    return w, cos_omega, 2.0 * cos_omega * cos_theta - math.cos(th)
+
+
 def _numerator(kind, th, ph, a, b, r, shadowing, m=None, sea_radiance=None, sky=None,
-               epsrel=1e-10, method="phi_outer"):
+               epsrel=1e-10, method="phi_outer", mean=(0.0, 0.0), epsabs=0.0):
     """Unnormalized integral of p cos(Omega)/cos(theta) [H] g over theta, phi (one scalar case)."""
-    fi = _FacetIntegral(th, ph, a, b, r, shadowing, kind, m, sea_radiance, sky)
-    return fi.integral(epsrel, method)
+    fi = _FacetIntegral(th, ph, a, b, r, shadowing, kind, m, sea_radiance, sky, mean)
+    return fi.integral(epsrel, method, epsabs)
 
 
-def _projected_area_scalar(th, ph, a, b, r, shadowing, epsrel, method):
+def _projected_area_scalar(th, ph, a, b, r, shadowing, epsrel, method, mean=(0.0, 0.0)):
     if a == 0.0 and b == 0.0:
+        if _is_shifted(mean):  # one tilted facet; hidden (weight 0) when it faces away
+            w = _mean_facet_weight(th, ph, mean)
+            return max(w, 0.0) if shadowing else w
         return math.cos(th)  # flat sea: every facet horizontal, cos(Omega) = cos(th) >= 0
-    return _numerator("area", th, ph, a, b, r, shadowing, epsrel=epsrel, method=method)
+    # shifted, no shadowing: the exact value cos th + sin th m can be ~0; stop at 1e-14 absolute
+    epsabs = 1e-14 if (_is_shifted(mean) and not shadowing) else 0.0
+    return _numerator("area", th, ph, a, b, r, shadowing, epsrel=epsrel, method=method, mean=mean,
+                      epsabs=epsabs)
 
 
-def _denominator(th, ph, a, b, r, shadowing, epsrel, method):
-    """D of Eq. 5 by quadrature (shadowing) or cos(th) of Eq. 7 (no shadowing)."""
+def _denominator(th, ph, a, b, r, shadowing, epsrel, method, mean=(0.0, 0.0)):
+    """D of Eq. 5 by quadrature (shadowing) or, without shadowing, the exact Eq. 4 denominator:
+    cos(th) (Eq. 7), cos th + sin th (mu . (cos ph, sin ph)) with a slope mean."""
     if shadowing:
-        return _projected_area_scalar(th, ph, a, b, r, True, epsrel, method)
+        return _projected_area_scalar(th, ph, a, b, r, True, epsrel, method, mean)
+    if _is_shifted(mean):
+        return _mean_facet_weight(th, ph, mean)
     return math.cos(th)
+
+
+def _shifted_denominator_or_nan(th, ph, a, b, r, shadowing, epsrel, method, mean):
+    """Shifted law: the denominator, or None where the weight's integral is 0 (result NaN, 0/0):
+    with shadowing no facet within the density support faces the sensor; without, the exact Eq. 4
+    denominator cos th + sin th m is 0 (|.| < 1e-15)."""
+    den = _denominator(th, ph, a, b, r, shadowing, epsrel, method, mean)
+    if den == 0.0 or (not shadowing and abs(den) < 1e-15):
+        return None
+    return den
 
 
 # ----------------------------------------------------------------------------- public API
 
 def projected_area(view_zenith, view_azimuth, slopes, shadowing=True, *, epsrel=1e-10,
-                   method="phi_outer"):
+                   method="phi_outer", slope_mean=(0.0, 0.0)):
     """Line-of-sight projected area per unit horizontal area: the denominator of Eq. 5 / Eq. 4.
 
     D(th, ph) = int_0^{2pi} dphi int_0^{pi/2} dtheta p(theta, phi) cos(Omega)/cos(theta) [H(pi/2 - Omega)]
@@ -362,22 +573,31 @@ def projected_area(view_zenith, view_azimuth, slopes, shadowing=True, *, epsrel=
     SlopeStatistics. Dimensionless. Broadcasts; returns a float64 array.
     epsrel: relative tolerance of the outer quadrature (inner uses epsrel/100).
     method: "phi_outer" (default) or "theta_outer" (independent ordering, for checks).
-    Flat sea (a = b = 0): cos(th) without quadrature. With shadowing=False and th = pi/2 exactly the
-    integral is 0 (cos(pi/2)); it is computed with an absolute tolerance of 1e-15 there.
+    slope_mean: (mean_upwind, mean_crosswind), the mean mu of the slope Gaussian (floats or arrays
+    broadcasting with the view); p is then N(s; mu, Sigma) in (theta, phi) form (module docstring).
+    Without shadowing the exact value is then cos th + sin th (mu . (cos ph, sin ph)), computed here by
+    quadrature with an absolute tolerance of 1e-14 (it can be 0 or negative). (0, 0): unchanged.
+    Flat sea (a = b = 0): cos(th) without quadrature; with a mean, one facet of slope mu:
+    cos th + sin th (mu . (cos ph, sin ph)), clipped at 0 with shadowing.
+    With shadowing=False and th = pi/2 exactly the (zero-mean) integral is 0 (cos(pi/2)); it is
+    computed with an absolute tolerance of 1e-15 there.
     """
     th, ph = _check_view(view_zenith, view_azimuth)
     a, b, r = _slope_arrays(slopes)
-    th, ph, a, b, r = np.broadcast_arrays(th, ph, a, b, r)
+    mx, my = _check_slope_mean(slope_mean)
+    th, ph, a, b, r, mx, my = np.broadcast_arrays(th, ph, a, b, r, mx, my)
     out = np.empty(th.shape, dtype=np.float64)
     for idx in np.ndindex(th.shape):
-        t_, p_, a_, b_, r_ = (float(x[idx]) for x in (th, ph, a, b, r))
-        if not shadowing and t_ == HALF_PI and not (a_ == 0.0 and b_ == 0.0):
+        t_, p_, a_, b_, r_, mx_, my_ = (float(x[idx]) for x in (th, ph, a, b, r, mx, my))
+        mean = (mx_, my_)
+        if (not shadowing and t_ == HALF_PI and not (a_ == 0.0 and b_ == 0.0)
+                and not _is_shifted(mean)):
             fi = _FacetIntegral(t_, p_, a_, b_, r_, False, "area")
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", integrate.IntegrationWarning)
                 out[idx] = _outer_abs(fi, 1e-15)
             continue
-        out[idx] = _projected_area_scalar(t_, p_, a_, b_, r_, shadowing, epsrel, method)
+        out[idx] = _projected_area_scalar(t_, p_, a_, b_, r_, shadowing, epsrel, method, mean)
     return out
 
 
@@ -391,7 +611,7 @@ def _outer_abs(fi, epsabs):
 
 
 def emissivity(view_zenith, view_azimuth, slopes, refractive_index, shadowing=True, *,
-               epsrel=1e-10, method="phi_outer"):
+               epsrel=1e-10, method="phi_outer", slope_mean=(0.0, 0.0)):
     """Rough-sea emissivity (dimensionless): int int f_hat(theta, phi) [1 - rho(Omega)] dtheta dphi.
 
     f_hat from Eq. 5 (shadowing=True: H(pi/2 - Omega) in numerator and denominator, the denominator
@@ -403,15 +623,37 @@ def emissivity(view_zenith, view_azimuth, slopes, refractive_index, shadowing=Tr
     integral is also 0 (odd in cos(phi - ph)); the result is NaN (0/0).
     Note: without shadowing, near grazing the numerator is a difference of terms ~rms slope that
     nearly cancel to ~cos(th); the relative accuracy is then ~1e-16 * slope / cos(th) at best.
+
+    slope_mean = (mean_upwind, mean_crosswind): mean mu of the slope Gaussian (module docstring).
+    Without shadowing the denominator is then the exact integral of the Eq. 4 weight,
+    cos th + sin th (mu . (cos ph, sin ph)) (Eq. 7's cos th needs mu = 0); where it is 0, and with
+    shadowing where no facet in the density support faces the sensor, the result is NaN (0/0).
+    Flat sea with a mean: the one facet of slope mu, 1 - rho(|cos Omega_mu|) (NaN if it is hidden).
     """
     th, ph = _check_view(view_zenith, view_azimuth)
     a, b, r = _slope_arrays(slopes)
     m = as_complex_index(refractive_index)
-    th, ph, a, b, r, m = np.broadcast_arrays(th, ph, a, b, r, m)
+    mx, my = _check_slope_mean(slope_mean)
+    th, ph, a, b, r, m, mx, my = np.broadcast_arrays(th, ph, a, b, r, m, mx, my)
     out = np.empty(th.shape, dtype=np.float64)
     for idx in np.ndindex(th.shape):
-        t_, p_, a_, b_, r_ = (float(x[idx]) for x in (th, ph, a, b, r))
+        t_, p_, a_, b_, r_, mx_, my_ = (float(x[idx]) for x in (th, ph, a, b, r, mx, my))
         m_ = complex(m[idx])
+        mean = (mx_, my_)
+        if _is_shifted(mean):
+            if a_ == 0.0 and b_ == 0.0:
+                w, cos_omega, _ = _tilted_flat_facet(t_, p_, mean)
+                visible = w > 0.0 if shadowing else abs(w) >= 1e-15
+                out[idx] = 1.0 - _fresnel_scalar(abs(cos_omega), m_) if visible else math.nan
+                continue
+            den = _shifted_denominator_or_nan(t_, p_, a_, b_, r_, shadowing, epsrel, method, mean)
+            if den is None:
+                out[idx] = math.nan
+                continue
+            num = _numerator("emis", t_, p_, a_, b_, r_, shadowing, m=m_, epsrel=epsrel,
+                             method=method, mean=mean)
+            out[idx] = num / den
+            continue
         if a_ == 0.0 and b_ == 0.0:
             out[idx] = 1.0 - _fresnel_scalar(math.cos(t_), m_)
             continue
@@ -424,7 +666,7 @@ def emissivity(view_zenith, view_azimuth, slopes, refractive_index, shadowing=Tr
 
 
 def apparent_radiance(view_zenith, view_azimuth, slopes, refractive_index, sea_radiance, sky,
-                      shadowing=True, *, epsrel=1e-10, method="phi_outer"):
+                      shadowing=True, *, epsrel=1e-10, method="phi_outer", slope_mean=(0.0, 0.0)):
     """Apparent radiance of the rough sea R_a, Eq. 10 (units of sea_radiance, W m^-2 sr^-1).
 
     R_a = int int f_hat(theta, phi) {[1 - rho(Omega)] R_B + rho(Omega) R_s(theta')} dtheta dphi,
@@ -436,17 +678,42 @@ def apparent_radiance(view_zenith, view_azimuth, slopes, refractive_index, sea_r
     angle with PchipInterpolator(extrapolate=False) and held at the end values outside the table.
     Flat sea (a = b = 0): (1 - rho(cos th)) R_B + rho(cos th) R_s(th) without quadrature.
     shadowing=False at th = pi/2 exactly (non-flat): NaN (0/0 in Eq. 7), as for emissivity().
+
+    slope_mean = (mean_upwind, mean_crosswind): mean mu of the slope Gaussian (module docstring);
+    denominator and NaN cases as in emissivity(). The sky stays in the world frame: theta' is the
+    zenith angle of the reflected ray whatever mu is. Flat sea with a mean: the one facet of slope mu,
+    (1 - rho) R_B + rho R_s(theta'_mu) (R_B if theta'_mu is below the horizontal; NaN if hidden).
     """
     th, ph = _check_view(view_zenith, view_azimuth)
     a, b, r = _slope_arrays(slopes)
     m = as_complex_index(refractive_index)
     rb = np.asarray(sea_radiance, dtype=np.float64)
     sky_f = _Sky(sky)
-    th, ph, a, b, r, m, rb = np.broadcast_arrays(th, ph, a, b, r, m, rb)
+    mx, my = _check_slope_mean(slope_mean)
+    th, ph, a, b, r, m, rb, mx, my = np.broadcast_arrays(th, ph, a, b, r, m, rb, mx, my)
     out = np.empty(th.shape, dtype=np.float64)
     for idx in np.ndindex(th.shape):
-        t_, p_, a_, b_, r_, rb_ = (float(x[idx]) for x in (th, ph, a, b, r, rb))
+        t_, p_, a_, b_, r_, rb_, mx_, my_ = (float(x[idx]) for x in (th, ph, a, b, r, rb, mx, my))
         m_ = complex(m[idx])
+        mean = (mx_, my_)
+        if _is_shifted(mean):
+            if a_ == 0.0 and b_ == 0.0:
+                w, cos_omega, cos_tp = _tilted_flat_facet(t_, p_, mean)
+                if not (w > 0.0 if shadowing else abs(w) >= 1e-15):
+                    out[idx] = math.nan
+                    continue
+                rho = _fresnel_scalar(abs(cos_omega), m_)
+                r_s = rb_ if cos_tp < 0.0 else sky_f(min(cos_tp, 1.0))
+                out[idx] = (1.0 - rho) * rb_ + rho * r_s
+                continue
+            den = _shifted_denominator_or_nan(t_, p_, a_, b_, r_, shadowing, epsrel, method, mean)
+            if den is None:
+                out[idx] = math.nan
+                continue
+            num = _numerator("rad", t_, p_, a_, b_, r_, shadowing, m=m_, sea_radiance=rb_,
+                             sky=sky_f, epsrel=epsrel, method=method, mean=mean)
+            out[idx] = num / den
+            continue
         if a_ == 0.0 and b_ == 0.0:
             rho = _fresnel_scalar(math.cos(t_), m_)
             out[idx] = (1.0 - rho) * rb_ + rho * sky_f(math.cos(t_))
