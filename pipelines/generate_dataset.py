@@ -1,4 +1,10 @@
-"""Generate a sea-background dataset: sharded 16-bit sensor images + per-image metadata.
+"""Generate a sea-background dataset: sharded 16-bit sensor images (or clips) + per-image metadata.
+
+The seas are textured by default (``scene.texture = true``: one wave-field realization per image,
+its seed and time [s] in the metadata); ``texture = false`` gives the expectation images.
+``clip_length = T > 1`` makes clips of T frames at ``frame_rate`` [Hz] from a camera on a
+moving platform (ranges in the ``[motion]`` table; ``pipelines/configs/sea_lwir_clips.toml``),
+with every frame's time, pose and noise seed in the metadata.
 
 One process (with DataLoader workers rendering shards in parallel):
 
@@ -36,7 +42,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", type=Path, help="output directory")
     ap.add_argument("--workers", type=int, default=0, help="DataLoader worker processes per rank (default 0: render in this process)")
     ap.add_argument("--threads", type=int, default=None, help="torch threads per rendering process (default: torch's)")
-    ap.add_argument("--num-images", type=int, default=None, help="override the config's num_images")
+    ap.add_argument("--num-images", type=int, default=None, help="override the config's num_images (clips, with clip_length > 1)")
     ap.add_argument("--no-progress", action="store_true")
     ap.add_argument("--print-default-config", action="store_true")
     args = ap.parse_args(argv)
@@ -72,7 +78,9 @@ def main(argv: list[str] | None = None) -> int:
         torch.distributed.barrier()
         torch.distributed.destroy_process_group()
     n = sum(e["images"] for e in manifest["shards"])
-    print(f"rank {rank}/{world}: {len(manifest['shards'])} shards, {n} images in {args.out} "
+    T = resolve_config(config)["clip_length"]
+    what = f"{n} images" if T == 1 else f"{n} clips of {T} frames"
+    print(f"rank {rank}/{world}: {len(manifest['shards'])} shards, {what} in {args.out} "
           f"({time.perf_counter() - t0:.1f} s this run)")
     return 0
 

@@ -40,7 +40,7 @@ from .slopes import SlopeStatistics, slope_pdf
 from .waves import WaveField, elfouhaily_spectrum
 from .motion import PlatformMotion, render_clip
 from . import atmosphere, augmentation, clutter, dataset, sensor, waves  # noqa: E402  (submodules as attributes: rs.sensor, ...)
-from .augmentation import RandomSeaBackground, SceneSampler
+from .augmentation import RandomSeaBackground, RandomSeaClip, SceneSampler
 from .dataset import SeaShardDataset
 from .sensor import SensorModel
 
@@ -67,6 +67,7 @@ __all__ = [
     "ViewGeometry",
     "Quadrature",
     "RandomSeaBackground",
+    "RandomSeaClip",
     "SceneSampler",
     "SeaShardDataset",
     "SensorModel",

@@ -5,15 +5,33 @@ Layout of an output directory::
 
     config.json               the resolved config (every default filled in); a resumed or
                               distributed run must find the same one
-    shard_000000.npz ...      numpy archives, one per ``shard_size`` images: ``images`` uint16
-                              (N, H, W) sensor counts, and per image ``index``, every scene
-                              parameter (float64), ``atmosphere`` (name), ``noise_seed``
+    shard_000000.npz ...      numpy archives, one per ``shard_size`` items: ``images`` uint16
+                              sensor counts, (N, H, W) for still images or (N, T, H, W) for clips
+                              of T = ``clip_length`` frames; per item ``index``, every scene
+                              parameter (float64), ``atmosphere`` (name), ``noise_seed`` (int64),
+                              ``image_seed`` (uint64); with ``scene.texture``: ``wave_seed``
+                              (int64) and ``time_s`` [s] (float64); for clips also the motion
+                              parameters (``pitch_amplitude_deg``, ``roll_amplitude_deg``,
+                              ``heave_amplitude_m`` [m], ``*_period_s`` [s], ``phase_rad``) and
+                              per frame (N, T): ``frame_time_s`` [s], ``frame_pitch_deg``,
+                              ``frame_roll_deg``, ``frame_altitude_m`` [m], ``frame_noise_seed``
     manifest_rank000.json     the shards a rank has finished (rewritten atomically per shard)
     manifest.json             all shards, written when the whole run is complete
 
-Determinism: image i is made only from (seed, i) (its parameters and noise streams come from
+Still images and clips. ``clip_length = 1`` (default) makes still images: a sea at the mean
+pose, textured (``scene.texture = true``, the default: one wave seed and a time per image) or
+the expectation image (``false``). ``clip_length = T > 1`` makes clips: one sea realization per
+clip, frame t at ``time_s`` + t / ``frame_rate`` [s], seen from a camera on a
+:class:`~roughsea_torch.motion.PlatformMotion` whose amplitudes and periods are drawn per clip
+from the ``[motion]`` ranges (:data:`~roughsea_torch.augmentation.MOTION_FIELDS`). Every frame is
+re-rendered exactly by :func:`~roughsea_torch.augmentation.render_parameters` of its item's fields
+with ``pitch_deg``, ``roll_deg``, ``altitude_m``, ``time_s`` replaced by the frame's, and its
+sensor noise drawn from ``frame_noise_seed``.
+
+Determinism: item i (image or clip) is made only from (seed, i) (its parameters, wave seed,
+motion and noise streams come from
 :func:`~roughsea_torch.augmentation.SceneSampler.sample_indexed`), and shard k always holds
-images [k·S, (k+1)·S) rendered together, so a shard's bytes do not depend on how many workers,
+items [k·S, (k+1)·S) rendered together, so a shard's bytes do not depend on how many workers,
 ranks or restarts made it. Writes go to a temporary name and are renamed into place (atomic on
 POSIX), so a killed run leaves whole shards or none; a restart makes only the missing ones.
 """
@@ -32,10 +50,21 @@ from typing import Any, Callable, Iterator
 import numpy as np
 import torch
 
-from .augmentation import SCENE_FIELDS, SceneSampler, image_seed, render_parameters
+from .augmentation import (
+    DEFAULT_TIME_S,
+    MOTION_FIELDS,
+    SCENE_FIELDS,
+    SceneSampler,
+    _range,
+    frame_parameters,
+    image_seed,
+    render_clip_parameters,
+    render_parameters,
+)
 from .radiometry import LWIR, MWIR, SpectralBand, as_band
 
-__all__ = ["DEFAULT_CONFIG", "resolve_config", "build_sensor", "generate", "SeaShardDataset", "shard_name"]
+__all__ = ["DEFAULT_CONFIG", "resolve_config", "build_sensor", "generate", "SeaShardDataset", "shard_name",
+           "frame_render_parameters"]
 
 DEFAULT_CONFIG: dict[str, Any] = {
     "seed": 0,
@@ -43,9 +72,13 @@ DEFAULT_CONFIG: dict[str, Any] = {
     "shard_size": 16,
     "batch_size": 4,
     "dtype": "float32",
+    "clip_length": 1,
+    "frame_rate": 25.0,
     "camera": {"height": 512, "width": 640},
     "scene": {"atmospheres": ["midlatitude_summer"], "band": "LWIR", "anisotropic": True, "path": True,
+              "texture": True, "time_s": list(DEFAULT_TIME_S),
               **{name: (list(d) if isinstance(d, tuple) else d) for name, _a, _u, d in SCENE_FIELDS}},
+    "motion": {name: list(d) for name, _a, _u, d in MOTION_FIELDS},
     "sensor": {
         "blur": {"sigma_px": 0.7},
         "noise": {"netd_k": 0.05},
@@ -69,11 +102,16 @@ def _band(name: Any) -> SpectralBand:
     raise ValueError(f"scene.band: 'LWIR', 'MWIR' or [lambda_lo_m, lambda_hi_m]; got {name!r}")
 
 
-def _sampler(scene: dict[str, Any]) -> SceneSampler:
+def _sampler(scene: dict[str, Any], motion: dict[str, Any] | None = None) -> SceneSampler:
     """The SceneSampler of a config's ``scene`` table (its ranges, checked against the path tables
-    when ``path`` is on; ``anisotropic`` aside)."""
-    return SceneSampler(band=_band(scene["band"]), **{k: (tuple(v) if isinstance(v, list) else v)
-                                                       for k, v in scene.items() if k not in ("band", "anisotropic")})
+    when ``path`` is on; ``anisotropic`` aside), with the ``motion`` ranges for clips."""
+    return SceneSampler(band=_band(scene["band"]), motion=motion,
+                        **{k: (tuple(v) if isinstance(v, list) else v) for k, v in scene.items() if k not in ("band", "anisotropic")})
+
+
+def _config_sampler(cfg: dict[str, Any]) -> SceneSampler:
+    """The sampler of a resolved config: with motion when it makes clips."""
+    return _sampler(cfg["scene"], cfg["motion"] if cfg["clip_length"] > 1 else None)
 
 
 def _stage_classes() -> dict[str, type]:
@@ -96,18 +134,29 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
     impossible poses (a camera at or below the sea), bad sizes raise ``ValueError`` naming the
     key. A sensor stage is left out by omitting its table or setting it to ``false``; the
     ``counts`` stage is required (shards hold 16-bit counts).
+
+    Keys beyond the scene ranges: ``scene.texture`` (bool, default true: textured seas, one wave
+    seed and one time per item; false: the expectation image), ``scene.time_s`` (range of the
+    realizations' times [s], default [0, 3600)), ``clip_length`` (frames per item, integer ≥ 1;
+    default 1: still images), ``frame_rate`` ([Hz], > 0, default 25; used by clips), and the
+    ``motion`` table (ranges of the platform's oscillations for clips, keys of
+    :data:`~roughsea_torch.augmentation.MOTION_FIELDS`: amplitudes [deg], [m], periods [s]).
     """
     if not isinstance(config, dict):
         raise ValueError("config must be a table/dict")
     _check_keys("", config, set(DEFAULT_CONFIG))
     cfg = copy.deepcopy(DEFAULT_CONFIG)
-    for key in ("seed", "num_images", "shard_size", "batch_size", "dtype"):
+    for key in ("seed", "num_images", "shard_size", "batch_size", "dtype", "clip_length", "frame_rate"):
         if key in config:
             cfg[key] = config[key]
-    for key, lo in (("seed", 0), ("num_images", 1), ("shard_size", 1), ("batch_size", 1)):
+    for key, lo in (("seed", 0), ("num_images", 1), ("shard_size", 1), ("batch_size", 1), ("clip_length", 1)):
         v = cfg[key]
         if not isinstance(v, int) or isinstance(v, bool) or v < lo:
             raise ValueError(f"config: {key} must be an integer >= {lo}; got {v!r}")
+    fr = cfg["frame_rate"]
+    if not isinstance(fr, (int, float)) or isinstance(fr, bool) or not (math.isfinite(fr) and fr > 0):
+        raise ValueError(f"config: frame_rate must be a number > 0 [Hz]; got {fr!r}")
+    cfg["frame_rate"] = float(fr)
     if cfg["dtype"] not in ("float32", "float64"):
         raise ValueError(f"config: dtype must be 'float32' or 'float64'; got {cfg['dtype']!r}")
     cam = config.get("camera", {})
@@ -122,13 +171,26 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
     cfg["scene"].update(scene)
     sc = cfg["scene"]
     _band(sc["band"])
-    for key in ("anisotropic", "path"):
+    for key in ("anisotropic", "path", "texture"):
         if not isinstance(sc[key], bool):
             raise ValueError(f"config: scene.{key} must be true or false; got {sc[key]!r}")
     try:
         _sampler(sc)
     except ValueError as e:
         raise ValueError(f"config: scene.{e}") from None
+    motion = config.get("motion", {})
+    if not isinstance(motion, dict):
+        raise ValueError(f"config: motion must be a table of ranges; got {motion!r}")
+    _check_keys("motion.", motion, set(DEFAULT_CONFIG["motion"]))
+    cfg["motion"].update(motion)
+    try:
+        if cfg["clip_length"] > 1:  # the ranges, and the pose ± amplitudes against the allowed poses
+            _sampler(sc, cfg["motion"])
+        else:  # still images do not move: only the ranges themselves
+            for name, allowed, unit, _d in MOTION_FIELDS:
+                _range(name, cfg["motion"][name], allowed, unit)
+    except ValueError as e:
+        raise ValueError(f"config: motion.{e}") from None
     sensor = config.get("sensor", {})
     _check_keys("sensor.", sensor, set(_SENSOR_STAGES))
     for stage in _SENSOR_STAGES:
@@ -197,36 +259,78 @@ def _write_json(path: Path, obj: Any) -> None:
 
 def render_shard(cfg: dict[str, Any], k: int, sensor: torch.nn.Module | None = None,
                  device: torch.device | str | None = None) -> dict[str, np.ndarray]:
-    """Images [k·S, (k+1)·S) of a resolved config: counts (uint16) and their parameters."""
+    """Items [k·S, (k+1)·S) of a resolved config: counts (uint16; (N, H, W), or (N, T, H, W) for
+    clips) and their parameters."""
     sc = cfg["scene"]
-    sampler = _sampler(sc)
+    sampler = _config_sampler(cfg)
     S, N = cfg["shard_size"], cfg["num_images"]
+    T = cfg["clip_length"]
     indices = list(range(k * S, min((k + 1) * S, N)))
     params = sampler.sample_indexed(cfg["seed"], indices)
+    frames = frame_parameters(params, T, cfg["frame_rate"]) if T > 1 else None
     sensor = sensor if sensor is not None else build_sensor(cfg)
     sensor = sensor.to(device) if device is not None else sensor
     dtype = getattr(torch, cfg["dtype"])
     H, W = cfg["camera"]["height"], cfg["camera"]["width"]
-    counts = np.empty((len(indices), H, W), dtype=np.uint16)
+    counts = np.empty((len(indices), T, H, W), dtype=np.uint16)
     bs = cfg["batch_size"]
     with torch.no_grad():
         for i in range(0, len(indices), bs):
             sub = {n: v[i : i + bs] for n, v in params.items()}
-            L = render_parameters(sub, H, W, sampler.atmospheres, band=_band(sc["band"]), anisotropic=sc["anisotropic"],
-                                  dtype=dtype, device=device, path=sc["path"])
+            kw = dict(band=_band(sc["band"]), anisotropic=sc["anisotropic"], dtype=dtype, device=device, path=sc["path"])
+            if T > 1:
+                L = render_clip_parameters(sub, T, cfg["frame_rate"], H, W, sampler.atmospheres, **kw)
+                seeds = frames["noise_seed"][i : i + bs]
+            else:
+                L = render_parameters(sub, H, W, sampler.atmospheres, **kw)[:, None]
+                seeds = sub["noise_seed"][:, None]
             # image by image: a shard's image is then exactly what re-rendering it alone from its metadata
             # gives (the blur's convolution may differ in the last bit between batch sizes)
             for j in range(L.shape[0]):
-                g = torch.Generator().manual_seed(int(sub["noise_seed"][j]))  # CPU draws: the same noise on any device
-                c = sensor(L[j : j + 1], generator=g)
-                counts[i + j] = c[0, 0].round().clamp(0, 65535).to(torch.int32).cpu().numpy().astype(np.uint16)
-    out = {"images": counts, "index": np.asarray(indices, dtype=np.int64)}
+                for t in range(T):
+                    g = torch.Generator().manual_seed(int(seeds[j, t]))  # CPU draws: the same noise on any device
+                    c = sensor(L[j, t : t + 1], generator=g)
+                    counts[i + j, t] = c[0, 0].round().clamp(0, 65535).to(torch.int32).cpu().numpy().astype(np.uint16)
+    out = {"images": counts if T > 1 else counts[:, 0], "index": np.asarray(indices, dtype=np.int64)}
     for name, *_r in SCENE_FIELDS:
         out[name] = params[name].numpy()
     out["atmosphere"] = np.asarray([sampler.atmospheres[a] for a in params["atmosphere"].tolist()])
     out["noise_seed"] = params["noise_seed"].numpy()
     out["image_seed"] = np.asarray([image_seed(cfg["seed"], i) for i in indices], dtype=np.uint64)
+    for name in ("wave_seed", "time_s"):  # texture on (absent otherwise: such shards are as before texture)
+        if name in params:
+            out[name] = params[name].numpy()
+    if frames is not None:
+        for name, *_r in MOTION_FIELDS:
+            out[name] = params[name].numpy()
+        out["phase_rad"] = params["phase_rad"].numpy()
+        for name in ("time_s", "pitch_deg", "roll_deg", "altitude_m", "noise_seed"):
+            out[f"frame_{name}"] = frames[name].numpy()
     return out
+
+
+def frame_render_parameters(meta: dict[str, Any], frame: int | None = None) -> dict[str, torch.Tensor]:
+    """The :func:`~roughsea_torch.augmentation.render_parameters` input (one image) of an item's
+    metadata (as :class:`SeaShardDataset` yields it, or a shard's arrays at one index), for a
+    still image or, with ``frame``, frame ``frame`` of a clip: its pose and time replaced by the
+    frame's. The atmosphere stays a name (``"atmosphere_name"``): map it to an index into the
+    atmospheres you render with. The sensor noise of the frame is ``frame_noise_seed[frame]`` (a
+    still: ``noise_seed``)."""
+    p = {k: torch.tensor([float(meta[k])], dtype=torch.float64) for k, *_r in SCENE_FIELDS}
+    if "wave_seed" in meta:
+        p["wave_seed"] = torch.tensor([int(meta["wave_seed"])], dtype=torch.int64)
+        p["time_s"] = torch.tensor([float(meta["time_s"])], dtype=torch.float64)
+    p["noise_seed"] = torch.tensor([int(meta["noise_seed"])], dtype=torch.int64)
+    if frame is not None:
+        if "frame_time_s" not in meta:
+            raise ValueError("frame: this item is a still image (no per-frame metadata); pass frame=None")
+        n = len(meta["frame_time_s"])
+        if not isinstance(frame, int) or not 0 <= frame < n:
+            raise ValueError(f"frame must be an int in [0, {n}); got {frame!r}")
+        for name in ("time_s", "pitch_deg", "roll_deg", "altitude_m"):
+            p[name] = torch.tensor([float(meta[f"frame_{name}"][frame])], dtype=torch.float64)
+        p["noise_seed"] = torch.tensor([int(meta["frame_noise_seed"][frame])], dtype=torch.int64)
+    return p
 
 
 def _sha256(path: Path) -> str:
@@ -269,7 +373,9 @@ def _metadata(cfg: dict[str, Any]) -> dict[str, Any]:
     return {"config": cfg, "band_m": [band.lo, band.hi], "roughsea_torch": __version__,
             "torch": torch.__version__.split("+")[0], "num_shards": num_shards(cfg),
             "units": {"images": "sensor counts (uint16); see sensor.counts for the radiance mapping",
-                      "temperatures": "K", "angles": "deg", "altitude_m": "m", "wind_speed": "m/s at 12.5 m"}}
+                      "temperatures": "K", "angles": "deg", "altitude_m": "m", "wind_speed": "m/s at 12.5 m",
+                      "time_s": "s", "frame_rate": "Hz", "heave_amplitude_m": "m", "periods": "s",
+                      "phase_rad": "rad"}}
 
 
 def generate(
@@ -344,7 +450,7 @@ def generate(
             from tqdm import tqdm
 
             bar = tqdm(total=sum(min(cfg["shard_size"], cfg["num_images"] - k * cfg["shard_size"]) for k in todo),
-                       unit="img", desc=f"rank {rank} shards", dynamic_ncols=True)
+                       unit="img" if cfg["clip_length"] == 1 else "clip", desc=f"rank {rank} shards", dynamic_ncols=True)
         for entry in loader:
             done[entry["shard"]] = entry
             manifest["shards"] = [done[k] for k in sorted(done)]
@@ -381,7 +487,9 @@ def finish(out: str | Path) -> dict[str, Any]:
 class SeaShardDataset(torch.utils.data.IterableDataset):
     """Stream the images of a generated dataset: yields ``(image, meta)`` with ``image`` a float32
     tensor (1, H, W) of sensor counts (or radiance [W m⁻² sr⁻¹] with ``radiance=True``, inverting
-    the counts stage) and ``meta`` a dict of that image's parameters.
+    the counts stage) and ``meta`` a dict of that image's parameters (Python numbers; the
+    atmosphere's name). For clips (``clip_length`` T > 1) ``image`` is (T, 1, H, W), kornia's
+    BTCHW once batched, and the per-frame fields (``frame_*``) are tensors (T,).
 
     Shards are split over ``torch.utils.data`` workers and, when ``torch.distributed`` is
     initialised (or ``rank``/``world_size`` are given), over ranks: each reads disjoint shards.
@@ -448,13 +556,17 @@ class SeaShardDataset(torch.utils.data.IterableDataset):
                 g = torch.Generator().manual_seed(self.seed * 1_000_003 + self.epoch * 7919 + int(arrays["index"][0]))
                 order = torch.randperm(n, generator=g).tolist()
             for i in order:
-                img = torch.from_numpy(arrays["images"][i].astype(np.float32))[None]
+                img = torch.from_numpy(arrays["images"][i].astype(np.float32))
+                img = img[None] if img.ndim == 2 else img[:, None]  # (1, H, W) or a clip's (T, 1, H, W)
                 if self.radiance:
                     img = self._to_radiance(img)
-                meta = {k: (v[i].item() if v.dtype.kind != "U" else str(v[i])) for k, v in arrays.items() if k != "images"}
+                meta = {k: (str(v[i]) if v.dtype.kind == "U" else torch.from_numpy(v[i].copy()) if v.ndim > 1 else v[i].item())
+                        for k, v in arrays.items() if k != "images"}
                 yield img, meta
 
     def _to_radiance(self, counts: torch.Tensor) -> torch.Tensor:
         if self._counts is None:
             self._counts = build_sensor(self.meta["config"]).counts
+        if counts.ndim == 4:  # a clip's frames are a batch
+            return self._counts.counts_to_radiance(counts)
         return self._counts.counts_to_radiance(counts[None])[0]

@@ -140,6 +140,107 @@ def test_rendering_matches_an_explicit_scene():
     assert not torch.allclose(img, no_path)
 
 
+def test_textured_parameters_reach_the_renderer():
+    """A textured draw renders, image by image, ``SeaScene(seed=wave_seed, time_s=time_s)``: the
+    seed and the time [s] reach the renderer (and the batch does not change an image)."""
+    s = SceneSampler(atmospheres=["tropical", "us_standard"], wind_speed=(4.0, 12.0), pitch_deg=(-15.0, -5.0),
+                     altitude_m=(10.0, 30.0), texture=True)
+    p = s.sample(3, generator=torch.Generator().manual_seed(4))
+    img = render_parameters(p, H, W, s.atmospheres, dtype=torch.float64)
+    for i in range(3):
+        cam = rs.make_camera(H, W, hfov_deg=float(p["hfov_deg"][i]), altitude_m=float(p["altitude_m"][i]),
+                             pitch_deg=float(p["pitch_deg"][i]), yaw_deg=float(p["yaw_deg"][i]),
+                             roll_deg=float(p["roll_deg"][i]), dtype=torch.float64)
+        scene = rs.SeaScene(wind_speed=float(p["wind_speed"][i]), wind_direction=math.radians(float(p["wind_direction_deg"][i])),
+                            sea_temperature=float(p["sea_temperature"][i]), sky=s.atmospheres[int(p["atmosphere"][i])],
+                            seed=int(p["wave_seed"][i]), time_s=float(p["time_s"][i]))
+        torch.testing.assert_close(img[i : i + 1], rs.render(cam, scene), rtol=1e-7, atol=0.0)
+        scene.time_s = float(p["time_s"][i]) + 5.0  # another moment of the same sea is another image
+        assert not torch.allclose(img[i : i + 1], rs.render(cam, scene), rtol=1e-5, atol=0.0)
+
+
+def test_texture_draws_come_after_the_old_ones():
+    """Texture adds a wave seed (int64) and a time (float64, within time_s) per image, drawn after
+    the other parameters: with the same generator seed, every other draw is what texture=False
+    (the behaviour before texture existed) draws."""
+    g = lambda: torch.Generator().manual_seed(21)  # noqa: E731
+    off = SceneSampler(atmospheres=["tropical", "us_standard"]).sample(64, generator=g())
+    on = SceneSampler(atmospheres=["tropical", "us_standard"], texture=True, time_s=(100.0, 200.0)).sample(64, generator=g())
+    assert set(on) - set(off) == {"wave_seed", "time_s"}
+    assert all(torch.equal(off[k], on[k]) for k in off)
+    assert on["wave_seed"].dtype == torch.int64 and len(set(on["wave_seed"].tolist())) == 64
+    assert on["time_s"].dtype == torch.float64
+    assert bool(((on["time_s"] >= 100.0) & (on["time_s"] < 200.0)).all()) and float(on["time_s"].std()) > 20.0
+    # the same through the augmentation: texture on and off share the scenes
+    a = small(generator=torch.Generator().manual_seed(5))
+    b = small(generator=torch.Generator().manual_seed(5), texture=False)
+    a(torch.zeros(2, 1, H, W))
+    b(torch.zeros(2, 1, H, W))
+    assert "wave_seed" not in b._params
+    assert all(torch.equal(a._params[k], b._params[k]) for k in off)
+
+
+def test_texture_replays_bit_for_bit_and_differs_between_draws():
+    aug = small(wind_speed=(5.0, 12.0), pitch_deg=(-15.0, -8.0), altitude_m=(10.0, 20.0), hfov_deg=30.0)
+    x = torch.zeros(3, 1, H, W)
+    y = aug(x, generator=torch.Generator().manual_seed(2))
+    params = {k: v.clone() for k, v in aug._params.items()}
+    assert torch.equal(aug(x, params=params), y)
+    assert torch.equal(aug(x, generator=torch.Generator().manual_seed(2)), y)
+    # another wave seed, everything else kept: the sea's clutter changes, the sky does not
+    other = dict(params, wave_seed=params["wave_seed"] + 1)
+    z = aug(x, params=other)
+    sea = rs.view_geometry(rs.make_camera(H, W, hfov_deg=30.0, altitude_m=params["altitude_m"],
+                                          pitch_deg=params["pitch_deg"], roll_deg=params["roll_deg"])).is_sea[:, None]
+    assert torch.equal(z[~sea], y[~sea])
+    for i in range(3):  # every image's near range (bottom rows) changes by a visible amount
+        assert float((z[i, 0, -4:] - y[i, 0, -4:]).abs().max()) > 0.02  # K
+    # and the same seed at another time is another frame of the same sea
+    later = dict(params, time_s=params["time_s"] + 10.0)
+    assert float((aug(x, params=later)[:, 0, -4:] - y[:, 0, -4:]).abs().max()) > 0.02
+
+
+@pytest.mark.parametrize("wind", [5.0, 12.0])
+def test_texture_is_zero_mean_clutter_around_the_expectation(wind):
+    """At near range (10 m up, 15° down) the texture departs from the expectation image by a
+    plausible clutter (std between 0.01 and 3 K); over four realizations the mean departure over
+    the sea pixels is a small fraction of it (the expectation is the ensemble mean; the
+    brightness temperature's curvature and four samples leave a little)."""
+    kw = dict(wind_speed=wind, pitch_deg=-15.0, altitude_m=10.0, roll_deg=0.0, hfov_deg=30.0, same_on_batch=True)
+    aug = small(**kw)
+    aug(torch.zeros(1, 1, H, W), generator=torch.Generator().manual_seed(0))
+    B = 4
+    params = {k: v.expand(B).clone() for k, v in aug._params.items() if v.ndim == 1 and v.shape[0] == 1}
+    params["wave_seed"] = torch.tensor([11, 2**40 + 3, 77777, 2**61 + 5])
+    tex = aug(torch.zeros(B, 1, H, W), params=params)
+    flat = small(texture=False, **kw)(torch.zeros(B, 1, H, W), params={k: v for k, v in params.items()
+                                                                       if k not in ("wave_seed", "time_s")})
+    sea = rs.view_geometry(rs.make_camera(H, W, hfov_deg=30.0, altitude_m=10.0, pitch_deg=-15.0)).is_sea[0]
+    d = (tex - flat)[:, 0][:, sea].double()
+    std, mean = float(d.std()), float(d.mean())
+    assert 0.01 < std < 3.0
+    assert abs(mean) < 0.2 * std
+    # the realizations differ from each other (not one texture repeated)
+    assert float((tex[0] - tex[1])[:, sea].abs().max()) > 0.1 * std
+
+
+def test_calm_sea_is_the_expectation_image():
+    """WaveField has no waves at W = 0: with texture on, a calm image is rendered as the
+    expectation (its wave seed and time are drawn and ignored), in a batch with textured ones."""
+    aug = small(wind_speed=0.0, pitch_deg=-10.0)
+    x = torch.zeros(2, 1, H, W)
+    y = aug(x, generator=torch.Generator().manual_seed(1))
+    assert "wave_seed" in aug._params
+    flat = small(texture=False)(x, params={k: v for k, v in aug._params.items() if k not in ("wave_seed", "time_s")})
+    assert torch.equal(y, flat)
+    mixed = {k: v.clone() for k, v in aug._params.items()}
+    mixed["wind_speed"] = torch.tensor([0.0, 8.0], dtype=torch.float64)
+    m = aug(x, params=mixed)
+    torch.testing.assert_close(m[:1], flat[:1], rtol=0, atol=1e-4)
+    ref = small(texture=False)(x, params={k: v for k, v in mixed.items() if k not in ("wave_seed", "time_s")})
+    assert not torch.allclose(m[1:], ref[1:], rtol=0, atol=1e-3)  # the windy one is textured
+
+
 @pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
 def test_composite_is_alpha_blending_in_radiance(dtype):
     aug = RandomSeaBackground(mode="composite", output="radiance")
@@ -195,6 +296,9 @@ def test_gradient_to_target_temperature():
         (dict(atmospheres=[]), "atmospheres"),
         (dict(mode="paste"), "mode"),
         (dict(output="counts"), "output"),
+        (dict(texture="yes"), "texture"),
+        (dict(time_s=(-1.0, 10.0)), "time_s"),
+        (dict(time_s=(20.0, 10.0)), "time_s"),
     ],
 )
 def test_bad_arguments_name_the_key(kwargs, key):
@@ -241,7 +345,8 @@ def test_cuda_matches_cpu():
 
 
 class _SeaImages(torch.utils.data.Dataset):
-    """Each item: one sea image drawn by the augmentation's own generator (what a user writes)."""
+    """Each item: one sea image drawn by the augmentation's own generator (what a user writes),
+    with the wave seed it drew."""
 
     def __init__(self, aug):
         self.aug = aug
@@ -250,26 +355,32 @@ class _SeaImages(torch.utils.data.Dataset):
         return 6
 
     def __getitem__(self, i):
-        return self.aug(torch.zeros(1, 1, 16, 20))[0], torch.utils.data.get_worker_info().id
+        img = self.aug(torch.zeros(1, 1, 16, 20))[0]
+        return img, int(self.aug._params["wave_seed"][0]), torch.utils.data.get_worker_info().id
 
 
 def _worker_images(seed):
-    aug = small(generator=torch.Generator().manual_seed(seed))
+    aug = small(generator=torch.Generator().manual_seed(seed), wind_speed=(5.0, 12.0))
     loader = torch.utils.data.DataLoader(_SeaImages(aug), batch_size=1, num_workers=2)
     out = {0: [], 1: []}
-    for img, wid in loader:
+    seeds = {0: [], 1: []}
+    for img, wave_seed, wid in loader:
         out[int(wid)].append(img[0])
-    return out
+        seeds[int(wid)].append(int(wave_seed))
+    return out, seeds
 
 
 def test_dataloader_workers_draw_their_own_scenes():
-    """A generator seeded once and copied into 2 DataLoader workers: the workers' scenes differ
-    (each worker gets its own stream), and a second run with the same seed repeats them all."""
-    a = _worker_images(3)
+    """A generator seeded once and copied into 2 DataLoader workers: the workers' scenes and wave
+    seeds differ (each worker gets its own stream), and a second run with the same seed repeats
+    them all."""
+    a, sa = _worker_images(3)
     assert len(a[0]) == len(a[1]) == 3
     assert all(not torch.equal(x, y) for x in a[0] for y in a[1])
-    b = _worker_images(3)
+    assert len(set(sa[0] + sa[1])) == 6  # six textures, none shared between or within workers
+    b, sb = _worker_images(3)
     assert all(torch.equal(x, y) for k in (0, 1) for x, y in zip(a[k], b[k]))
+    assert sa == sb
     # the replay from kept parameters is unaffected (outside workers, from the instance's generator)
     aug = small(generator=torch.Generator().manual_seed(3))
     y = aug(torch.zeros(2, 1, 16, 20))

@@ -14,7 +14,15 @@ import pytest
 import torch
 
 from roughsea_torch.augmentation import SceneSampler, render_parameters
-from roughsea_torch.dataset import SeaShardDataset, build_sensor, finish, generate, resolve_config, shard_name
+from roughsea_torch.dataset import (
+    SeaShardDataset,
+    build_sensor,
+    finish,
+    frame_render_parameters,
+    generate,
+    resolve_config,
+    shard_name,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 CFG = {
@@ -92,22 +100,88 @@ def test_torchrun(reference, tmp_path):
 
 
 def test_metadata_reproduces_each_image(reference):
-    """Every parameter that made an image is in its metadata: re-rendering from it gives the
-    same counts."""
+    """Every parameter that made an image is in its metadata, the wave seed and time of its
+    textured sea included (texture is on by default): re-rendering from it gives the same counts."""
     cfg = resolve_config(CFG)
+    assert cfg["scene"]["texture"] is True and cfg["clip_length"] == 1
     sensor = build_sensor(cfg)
     ds = list(SeaShardDataset(reference))
     assert [m["index"] for _, m in ds] == list(range(7))
     atmospheres = ("tropical", "us_standard")
+    textured = []
     for img, meta in ds[:3]:
         p = {k: torch.tensor([meta[k]], dtype=torch.float64) for k in SceneSampler().ranges}
+        p["wave_seed"] = torch.tensor([meta["wave_seed"]])
+        p["time_s"] = torch.tensor([meta["time_s"]], dtype=torch.float64)
         p["atmosphere"] = torch.tensor([atmospheres.index(meta["atmosphere"])])
         L = render_parameters(p, 20, 28, atmospheres)
         c = sensor(L, generator=torch.Generator().manual_seed(int(meta["noise_seed"])))
         assert torch.equal(c[0].round(), img)
+        del p["wave_seed"]  # the expectation image of the same parameters
+        flat = sensor(render_parameters(p, 20, 28, atmospheres), generator=torch.Generator().manual_seed(int(meta["noise_seed"])))
+        textured.append(not torch.equal(flat[0].round(), img))
+    # the texture is in the images (1.4° pixels from 10–100 m up resolve few waves: not in every one)
+    assert any(textured)
     # the same parameters come from the sampler at (seed, index): nothing else made them
-    s = SceneSampler(atmospheres=atmospheres, wind_speed=(2.0, 12.0), air_temperature=(285.0, 300.0)).sample_indexed(5, [4])
+    s = SceneSampler(atmospheres=atmospheres, wind_speed=(2.0, 12.0), air_temperature=(285.0, 300.0),
+                     texture=True).sample_indexed(5, [4])
     assert float(s["wind_speed"][0]) == ds[4][1]["wind_speed"]
+    assert int(s["wave_seed"][0]) == ds[4][1]["wave_seed"] and float(s["time_s"][0]) == ds[4][1]["time_s"]
+    assert 0.0 <= ds[4][1]["time_s"] < 3600.0
+
+
+CLIPS = dict(CFG, num_images=2, shard_size=1, clip_length=3, frame_rate=5.0,
+             scene=dict(CFG["scene"], pitch_deg=[-12.0, -6.0], altitude_m=[10.0, 30.0]),
+             motion={"pitch_amplitude_deg": [1.0, 2.0], "roll_amplitude_deg": 3.0, "heave_period_s": [6.0, 8.0]})
+
+
+def test_clips_reproduce_every_frame_from_metadata(tmp_path):
+    """clip_length = 3 frames at 5 Hz: each item is a clip (T, 1, H, W); its metadata holds the
+    per-frame time, pose and noise seed, and re-rendering any frame alone from them gives its
+    counts; the frames are 0.2 s apart and the camera pitches between them."""
+    generate(CLIPS, tmp_path, progress=False)
+    with np.load(tmp_path / shard_name(1)) as z:
+        assert z["images"].shape == (1, 3, 20, 28) and z["frame_time_s"].shape == (1, 3)
+    cfg = resolve_config(CLIPS)
+    sensor = build_sensor(cfg)
+    atmospheres = ("tropical", "us_standard")
+    items = list(SeaShardDataset(tmp_path))
+    assert [m["index"] for _, m in items] == [0, 1]
+    for clip, meta in items:
+        assert clip.shape == (3, 1, 20, 28)
+        torch.testing.assert_close(meta["frame_time_s"], meta["time_s"] + torch.tensor([0.0, 0.2, 0.4], dtype=torch.float64),
+                                   rtol=0, atol=1e-9)
+        assert 1.0 <= meta["pitch_amplitude_deg"] <= 2.0 and meta["roll_amplitude_deg"] == 3.0
+        assert float(meta["frame_pitch_deg"].max() - meta["frame_pitch_deg"].min()) > 0.0
+        assert len(set(meta["frame_noise_seed"].tolist())) == 3
+        for t in range(3) if meta["index"] == 0 else [2]:
+            p = frame_render_parameters(meta, t)
+            p["atmosphere"] = torch.tensor([atmospheres.index(meta["atmosphere"])])
+            L = render_parameters(p, 20, 28, atmospheres)
+            c = sensor(L, generator=torch.Generator().manual_seed(int(p["noise_seed"])))
+            assert torch.equal(c[0].round(), clip[t])
+    # batches of clips collate to kornia's (B, T, C, H, W)
+    x, m = next(iter(torch.utils.data.DataLoader(SeaShardDataset(tmp_path), batch_size=2)))
+    assert x.shape == (2, 3, 1, 20, 28) and m["frame_time_s"].shape == (2, 3)
+    with pytest.raises(ValueError, match="frame"):
+        frame_render_parameters(meta, 3)
+
+
+def test_texture_off_makes_expectation_images(tmp_path):
+    """scene.texture = false: the shards hold no wave seed, and each image is the expectation
+    image of its parameters (as before texture existed)."""
+    cfg = dict(CFG, num_images=2, shard_size=2, scene=dict(CFG["scene"], texture=False))
+    generate(cfg, tmp_path, progress=False)
+    sensor = build_sensor(resolve_config(cfg))
+    with np.load(tmp_path / shard_name(0)) as z:
+        assert "wave_seed" not in z.files and "time_s" not in z.files
+    for img, meta in SeaShardDataset(tmp_path):
+        p = frame_render_parameters(meta)
+        assert "wave_seed" not in p
+        p["atmosphere"] = torch.tensor([("tropical", "us_standard").index(meta["atmosphere"])])
+        c = sensor(render_parameters(p, 20, 28, ("tropical", "us_standard")),
+                   generator=torch.Generator().manual_seed(int(meta["noise_seed"])))
+        assert torch.equal(c[0].round(), img)
 
 
 def test_reader_splits_over_workers_and_converts_to_radiance(reference):
@@ -150,6 +224,14 @@ def test_reader_splits_over_workers_and_converts_to_radiance(reference):
         ({"sensor": {"counts": False}}, "sensor.counts"),
         ({"sensor": {"counts": {"bits": 20}}}, "sensor.counts.bits"),
         ({"sensor": {"lens": {}}}, "sensor.lens"),
+        ({"scene": {"texture": "yes"}}, "scene.texture"),
+        ({"scene": {"time_s": [-5.0, 10.0]}}, "scene.time_s"),
+        ({"clip_length": 0}, "clip_length"),
+        ({"frame_rate": 0.0}, "frame_rate"),
+        ({"motion": {"pitch_amp": 1.0}}, "motion.pitch_amp"),
+        ({"motion": {"roll_period_s": [3.0, 1.0]}}, "motion.roll_period_s"),
+        ({"clip_length": 4, "motion": {"heave_amplitude_m": 9.5}, "scene": {"altitude_m": [10.0, 20.0]}},
+         "motion.heave_amplitude_m"),
     ],
 )
 def test_invalid_configs_fail_before_any_work(patch, key, tmp_path):
@@ -203,7 +285,8 @@ def test_a_sensor_stage_left_out(tmp_path):
     s = build_sensor(resolve_config(cfg))
     assert s.noise is None and s.blur is not None
     with np.load(tmp_path / "quiet" / shard_name(0)) as z:
-        p = {k: torch.from_numpy(np.asarray(z[k], dtype=np.float64)) for k in SceneSampler().ranges}
+        p = {k: torch.from_numpy(np.asarray(z[k], dtype=np.float64)) for k in [*SceneSampler().ranges, "time_s"]}
+        p["wave_seed"] = torch.from_numpy(z["wave_seed"])
         p["atmosphere"] = torch.tensor([("tropical", "us_standard").index(str(a)) for a in z["atmosphere"]])
     L = render_parameters(p, 20, 28, ("tropical", "us_standard"))
     a = torch.cat([s(L[i : i + 1], generator=torch.Generator().manual_seed(1)) for i in range(2)]).round()
