@@ -609,7 +609,7 @@ def render(
     table: TableSize = TableSize(),
     quadrature: Quadrature | None = None,
     geometry: ViewGeometry | None = None,
-    chunk: int = 4,
+    chunk: int | None = None,
 ) -> torch.Tensor:
     """Render infrared images of the sea seen by a batch of kornia cameras.
 
@@ -623,8 +623,9 @@ def render(
         table: node counts of the table method.
         quadrature: accuracy control of the model (default for the dtype).
         geometry: a precomputed :func:`view_geometry` of these cameras (reused across scenes).
-        chunk: images whose per-pixel temporaries are held at once (memory bound; the model is
-            evaluated for the whole batch in one call).
+        chunk: images whose per-pixel temporaries are held at once (memory bound; results do not
+            depend on it); default 4, and 1 for textured scenes (``seed=``), whose per-pixel work
+            holds a dozen more full-size temporaries.
 
     Returns:
         (B, 1, H, W) tensor in the cameras' dtype and device; differentiable with respect to every
@@ -632,6 +633,8 @@ def render(
     """
     if method not in ("table", "direct"):
         raise ValueError(f"method must be 'table' or 'direct'; got {method!r}")
+    if chunk is None:
+        chunk = 1 if scene.seed is not None else 4
     if output not in ("radiance", "brightness_temperature"):
         raise ValueError(f"output must be 'radiance' or 'brightness_temperature'; got {output!r}")
     if geometry is not None:
