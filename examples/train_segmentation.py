@@ -87,8 +87,9 @@ def normalise(counts: torch.Tensor) -> torch.Tensor:
     return (counts - m) / s
 
 
-def make_augmentation(seed: int = 0) -> RandomSeaBackground:
+def make_augmentation(seed: int = 0, texture: bool = True) -> RandomSeaBackground:
     return RandomSeaBackground(
+        texture=texture,
         wind_speed=(1.0, 14.0), sea_temperature=(286.0, 298.0), air_temperature=(284.0, 300.0),
         atmospheres=["midlatitude_summer", "tropical", "us_standard"], altitude_m=(8.0, 40.0),
         pitch_deg=(-6.0, -2.0), roll_deg=(-1.5, 1.5), hfov_deg=(12.0, 24.0),

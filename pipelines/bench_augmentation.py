@@ -85,6 +85,8 @@ def main() -> None:
     ap.add_argument("--gen-images", type=int, default=24, help="images per generator run")
     ap.add_argument("--train-steps", type=int, default=12)
     ap.add_argument("--out", type=Path, default=ROOT / "docs")
+    ap.add_argument("--texture", action=argparse.BooleanOptionalAction, default=True,
+                    help="textured seas (RandomSeaBackground's default) or expectation images (--no-texture)")
     a = ap.parse_args()
     dev = torch.device(a.device)
     sync = (lambda: torch.cuda.synchronize()) if dev.type == "cuda" else (lambda: None)
@@ -92,13 +94,13 @@ def main() -> None:
     machine = (f"{cpu_name()}, {os.cpu_count()} cores, torch {torch.__version__} with {torch.get_num_threads()} threads"
                + (f", GPU {torch.cuda.get_device_name(dev)}" if dev.type == "cuda" else ""))
     lines = [f"# On-the-fly sea backgrounds ({dt.date.today().isoformat()})", "",
-             f"Machine: {machine}. Command: `python pipelines/bench_augmentation.py --repeats {a.repeats} --batch {B} --height {H} --width {W} --device {a.device}`.", ""]
+             f"Machine: {machine}. Command: `python pipelines/bench_augmentation.py --repeats {a.repeats} --batch {B} --height {H} --width {W} --device {a.device}{'' if a.texture else ' --no-texture'}`.", ""]
 
     # 1. sensor and augmentation against the renderer, 1 and 2 threads, without and with load
     threads0 = torch.get_num_threads()
     g = torch.Generator().manual_seed(0)
-    aug = RandomSeaBackground(sensor=SensorModel.typical_lwir()).to(dev)
-    comp = make_augmentation().to(dev)
+    aug = RandomSeaBackground(sensor=SensorModel.typical_lwir(), texture=a.texture).to(dev)
+    comp = make_augmentation(texture=a.texture).to(dev)
     x = torch.zeros(B, 1, H, W, device=dev)
     chips = ship_chips(B, H, W, torch.Generator().manual_seed(1)).to(dev)
     sampler = aug.sampler
