@@ -87,14 +87,21 @@ def _rss_mb() -> float:
 def memory_child(b: int, kind: str) -> None:
     """Peak resident memory of one render of b images over the process's resident memory just
     before it (after a warm-up render), sampled every millisecond from /proc/self/status."""
-    import threading
-
     cam, sc = batch(b)
     extra = dict(sky=analytic_sky) if kind == "callable" else {}
     small = rs.make_camera(8, 8, **{k: v[:1] for k, v in cam.items()})
     rs.render(small, rs.SeaScene(**{k: v[:1] for k, v in sc.items()}, **extra))
     cams = rs.make_camera(H, W, **cam)
     scene = rs.SeaScene(**sc, **extra)
+    img, peak = peak_memory(lambda: rs.render(cams, scene))
+    print(json.dumps({"peak_mb": peak, "output_mb": img.numel() * img.element_size() / 2**20}))
+
+
+def peak_memory(fn):
+    """(fn(), peak resident memory [MB] during it over the resident memory just before it), sampled
+    every millisecond from /proc/self/status."""
+    import threading
+
     base = _rss_mb()
     peak = [base]
     done = threading.Event()
@@ -106,11 +113,10 @@ def memory_child(b: int, kind: str) -> None:
 
     t = threading.Thread(target=poll)
     t.start()
-    img = rs.render(cams, scene)
+    out = fn()
     done.set()
     t.join()
-    peak[0] = max(peak[0], _rss_mb())
-    print(json.dumps({"peak_mb": peak[0] - base, "output_mb": img.numel() * img.element_size() / 2**20}))
+    return out, max(peak[0], _rss_mb()) - base
 
 
 class Competitor:

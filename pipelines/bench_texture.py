@@ -21,14 +21,13 @@ import os
 import platform
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
 import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_render import B, H, W, _rss_mb, batch, med  # noqa: E402
+from bench_render import B, H, W, batch, med, peak_memory  # noqa: E402
 
 import roughsea_torch as rs  # noqa: E402
 
@@ -46,22 +45,8 @@ def memory_child(kind: str) -> None:
     rs.render(small, rs.SeaScene(**{k: v[:1] for k, v in sc.items()}, **extra))
     cams = rs.make_camera(H, W, **cam)
     scene = rs.SeaScene(**sc, **(dict(seed=list(range(B)), time_s=12.5) if kind == "textured" else {}))
-    base = _rss_mb()
-    peak = [base]
-    done = threading.Event()
-
-    def poll() -> None:
-        while not done.is_set():
-            peak[0] = max(peak[0], _rss_mb())
-            time.sleep(0.001)
-
-    t = threading.Thread(target=poll)
-    t.start()
-    img = rs.render(cams, scene)
-    done.set()
-    t.join()
-    peak[0] = max(peak[0], _rss_mb())
-    print(json.dumps({"peak_mb": peak[0] - base, "output_mb": img.numel() * img.element_size() / 2**20}))
+    img, peak = peak_memory(lambda: rs.render(cams, scene))
+    print(json.dumps({"peak_mb": peak, "output_mb": img.numel() * img.element_size() / 2**20}))
 
 
 def stages(cams, textured) -> list[tuple[str, float]]:
