@@ -39,6 +39,7 @@ from .sensitivity import pixel_derivative
 from .slopes import SlopeStatistics, slope_pdf
 from .waves import WaveField, elfouhaily_spectrum
 from .motion import PlatformMotion, render_clip
+from .sun import Sun, glint_radiance
 from . import atmosphere, augmentation, clutter, dataset, sensor, waves  # noqa: E402  (submodules as attributes: rs.sensor, ...)
 from .augmentation import RandomSeaBackground, RandomSeaClip, SceneSampler
 from .dataset import SeaShardDataset
@@ -53,6 +54,8 @@ __all__ = [
     "waves",
     "WaveField",
     "PlatformMotion",
+    "Sun",
+    "glint_radiance",
     "elfouhaily_spectrum",
     "render_clip",
     "dataset",

@@ -552,6 +552,8 @@ def apparent_radiance(
     sky: Any = None,
     shadowing: bool = True,
     quadrature: Quadrature | None = None,
+    sun: Any = None,
+    sun_masking: bool = True,
 ) -> torch.Tensor:
     """Apparent radiance of the rough sea, Eq. 10 [W m⁻² sr⁻¹ (units of the radiances given)].
 
@@ -568,6 +570,10 @@ def apparent_radiance(
             :class:`~roughsea_torch.sky.TabulatedSky`, a constant, or a named atmosphere.
         shadowing: Eq. 5 (True, default) or Eq. 7.
         quadrature: accuracy control; ``Quadrature.default(dtype)`` when None.
+        sun: ``None`` (default: no sun, every result as without it) or a
+            :class:`~roughsea_torch.sun.Sun`: its reflection off the waves (the glint,
+            :func:`~roughsea_torch.sun.glint_radiance`) is added; ``sky`` is then the rest of the sky.
+        sun_masking: with a sun, Smith's masking of the facets from the sun's side (default True).
 
     Returns:
         R_a, the broadcast shape of the inputs (including a batched sky's leading dims).
@@ -585,7 +591,14 @@ def apparent_radiance(
         view_zenith, view_azimuth, slopes, refractive_index, sky, shadowing, quadrature, dict(sea_radiance=sea_radiance)
     )
     rb = as_tensor(sea_radiance, dtype, t_s.device).to(t_s.dtype)
-    return (rb - rb * t_rho + t_s).to(dtype)
+    out = (rb - rb * t_rho + t_s).to(dtype)
+    if sun is not None:
+        from .sun import Sun, glint_radiance
+
+        if not isinstance(sun, Sun):
+            raise ValueError(f"sun must be None or a roughsea_torch.Sun; got {type(sun).__name__}")
+        out = out + glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun, shadowing, sun_masking)
+    return out
 
 
 def reflection_terms(

@@ -1,0 +1,227 @@
+"""The reflected sun (glint) in the facet-weighted expectation (``docs/waves.md`` §5).
+
+The sun is a uniform disk of radiance L_sun = E_sun / Ω_sun, angular radius α (0.267°, Ω_sun =
+2π(1 − cos α) ≈ 6.8e-5 sr) and direction ω_sun. In Eq. 10 it replaces R_s(θ') on the facets whose
+mirror direction falls in the disk, so its contribution is
+
+    R_glint = (1/D) ∫_E N(s; μ, Σ) t(s) ρ(Ω(s)) L_sun ds,
+
+E the set of slopes that reflect the line of sight into the disk, D the Eq. 5 (or Eq. 7)
+denominator. The disk is small, so E is an ellipse about the specular slope s_g = (p_x, p_y)/p_z,
+p = v + ω_sun (v the line of sight), the image of the disk under the linearized map ω → s
+(∂s/∂ω = (e_xy − s e_z)/p_z along the disk's tangent basis e); t and ρ are taken at the mean slope
+of the facets in E, s* = E[s | s ∈ E] (s_g for broad slopes, the mean slope on a calm sea; they vary
+by O(α tan θ̂) across E). What remains is the Gaussian probability of the ellipse,
+P = ∫_E N ds, computed exactly for any width: in whitened
+slopes the ellipse is E' and P = (1/2π) ∫ [exp(−ρ₁²/2) − exp(−ρ₂²/2)] dψ over the rays from the
+mean, ρ₁ < ρ₂ where a ray enters and leaves E' (ρ₁ → 0 when the mean lies inside E'). So
+
+- slopes broader than the disk: P → N(s_g) · area(E), and R_glint → ρ E_sun N(s_g) / (4 D cos⁴β_g),
+  Cox & Munk's (1954) sun-glitter formula (with D = cos θ̂ without shadowing);
+- a calm sea (slopes narrower than the disk): P → 1 inside the sun's mirror image and 0 outside, and
+  R_glint → ρ L_sun (a flat sea mirrors the sun), finite, with finite gradients.
+
+View side: the shadowing of Eq. 5 (D), as for the sky. Sun side (not in the paper): Smith's (1967)
+masking of the facets from the sun, G1 = e_s / D_s with D_s the projected area of the facets seen
+from the sun (Eq. 5's denominator for the sun's direction) and e_s that of their mean plane
+(cos θ_sun for zero-mean slopes, so G1 = 1/(1 + Λ_sun)); ``sun_masking=False`` leaves it out.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import torch
+
+from ._validation import as_tensor, check_finite_range
+
+__all__ = ["Sun", "SUN_RADIUS", "glint_radiance"]
+
+SUN_RADIUS = math.radians(0.2666)  # angular radius of the sun's disk at 1 AU [rad]
+_SQRT_HALF = math.sqrt(0.5)
+_N_RAYS = 48  # rays from the mean over the ellipse (Gauss–Legendre, or uniform when the mean is inside)
+
+
+@dataclass(frozen=True)
+class Sun:
+    """The sun as a small disk in the sky.
+
+    Args:
+        zenith: zenith angle of the sun's centre [rad] (> π/2: below the horizon, no glint).
+        azimuth: its azimuth [rad], measured like ``view_azimuth`` (from the upwind axis).
+        irradiance: E_sun, the direct irradiance at the surface on a plane normal to the beam
+            [W m⁻² in the band], ≥ 0.
+        radius: angular radius of the disk [rad] (0.267°).
+
+    Floats or tensors broadcasting with the view angles; gradients flow to all of them.
+    """
+
+    zenith: Any
+    azimuth: Any
+    irradiance: Any
+    radius: Any = SUN_RADIUS
+
+    def __post_init__(self) -> None:
+        check_finite_range("sun zenith", self.zenith, 0.0, math.pi, unit="rad")
+        check_finite_range("sun azimuth", self.azimuth, unit="rad")
+        check_finite_range("sun irradiance", self.irradiance, 0.0, unit="W m-2")
+        check_finite_range("sun radius", self.radius, 0.0, 0.1, lo_open=True, unit="rad")
+
+    @property
+    def solid_angle(self) -> Any:
+        """Ω_sun = 2π (1 − cos α) [sr]."""
+        r = self.radius
+        return 4.0 * math.pi * (torch.sin(r / 2) ** 2 if isinstance(r, torch.Tensor) else math.sin(r / 2) ** 2)
+
+
+def _nodes(n: int, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, torch.Tensor]:
+    x, w = np.polynomial.legendre.leggauss(n)
+    return torch.as_tensor(x, dtype=dtype, device=device), torch.as_tensor(w, dtype=dtype, device=device)
+
+
+def _ellipse_probability(cx: torch.Tensor, cy: torch.Tensor, k11: torch.Tensor, k12: torch.Tensor,
+                         k22: torch.Tensor, det_k: torch.Tensor) -> torch.Tensor:
+    """P(z ∈ E') for z ~ N(0, I₂), E' = {z : (z − c)ᵀ K (z − c) ≤ 1} (K symmetric positive definite,
+    det_k its determinant, given from its factors so that it carries no cancellation).
+
+    Along a ray z = ρ d from the origin, (ρ d − c)ᵀ K (ρ d − c) ≤ 1 between the roots ρ₁ ≤ ρ₂ of
+    a ρ² − 2 b ρ + c₀ = 0 (a = dᵀKd, b = dᵀKc, c₀ = cᵀKc − 1), and the ray carries
+    (1/2π)[exp(−max(ρ₁, 0)²/2) − exp(−ρ₂²/2)] of the probability. The discriminant is taken as
+    b² − a c₀ = a − det K (d × c)² (Lagrange's identity), free of the cancellation of the textbook
+    form when E' is small and far. With the origin inside E' (c₀ < 0) every ray counts: a uniform
+    rule over the angle (periodic, smooth). Outside, only the rays between the two tangents
+    (a = det K (d × c)²) do: Gauss–Legendre over that angle, substituted ψ = m + h sin(πx/2) so that
+    the square-root ends of the integrand become smooth.
+    """
+    dtype, device = cx.dtype, cx.device
+    kc1, kc2 = k11 * cx + k12 * cy, k12 * cx + k22 * cy
+    c0 = cx * kc1 + cy * kc2 - 1.0
+    inside = c0 < 0
+    # the tangents, in the frame of the direction to the centre (both within ±π/2 of it):
+    # (K'₂₂ − det K |c|²) tan²ψ + 2 K'₁₂ tanψ + K'₁₁ = 0, K' = K rotated into (ê_c, ê_c⊥)
+    th_c = torch.atan2(cy, cx)
+    cth, sth = torch.cos(th_c), torch.sin(th_c)
+    r11 = cth * cth * k11 + 2 * cth * sth * k12 + sth * sth * k22
+    r12 = (k22 - k11) * cth * sth + k12 * (cth * cth - sth * sth)
+    r22 = sth * sth * k11 - 2 * cth * sth * k12 + cth * cth * k22 - det_k * (cx * cx + cy * cy)
+    disc = torch.sqrt((r12 * r12 - r11 * r22).clamp_min(0.0))
+    r22s = torch.where(r22 < 0, r22, -torch.ones_like(r22))
+    t1, t2 = torch.atan((-r12 - disc) / r22s), torch.atan((-r12 + disc) / r22s)
+    psi1, psi2 = torch.minimum(t1, t2), torch.maximum(t1, t2)
+    x, w = _nodes(_N_RAYS, dtype, device)
+    mid, half = 0.5 * (psi1 + psi2), 0.5 * (psi2 - psi1)
+    u = torch.sin(0.5 * math.pi * x)
+    du = 0.5 * math.pi * torch.cos(0.5 * math.pi * x)
+    psi_out = mid[..., None] + half[..., None] * u
+    w_out = half[..., None] * du * w / (2.0 * math.pi)
+    psi_in = torch.arange(_N_RAYS, dtype=dtype, device=device) * (2.0 * math.pi / _N_RAYS)
+    w_in = torch.full_like(psi_in, 1.0 / _N_RAYS)
+    psi = torch.where(inside[..., None], psi_in, psi_out)
+    wts = torch.where(inside[..., None], w_in, w_out)
+    th = th_c[..., None] + psi
+    dx, dy = torch.cos(th), torch.sin(th)
+    a = k11[..., None] * dx * dx + 2 * k12[..., None] * dx * dy + k22[..., None] * dy * dy
+    b = kc1[..., None] * dx + kc2[..., None] * dy
+    cross = dx * cy[..., None] - dy * cx[..., None]
+    root = torch.sqrt((a - det_k[..., None] * cross * cross).clamp_min(0.0))
+    rho2 = (b + root) / a
+    # ρ₁ = c₀ / (a ρ₂) without cancellation (the product of the roots is c₀/a)
+    rho1 = torch.where(inside[..., None], torch.zeros_like(rho2),
+                       c0[..., None] / (a * torch.where(rho2 > 0, rho2, torch.ones_like(rho2))))
+    e1, e2 = torch.exp(-0.5 * rho1 * rho1), torch.exp(-0.5 * rho2 * rho2)
+    prob = (wts * (e1 - e2)).sum(-1).clamp(0.0, 1.0)
+    # first moment ∫_E' z φ₂(z) dz: along a ray ∫ ρ² e^{−ρ²/2} dρ = F(ρ), F = √(π/2) erf(ρ/√2) − ρ e^{−ρ²/2}
+    rt = math.sqrt(math.pi / 2)
+    m = (rt * (torch.erfc(rho1 * _SQRT_HALF) - torch.erfc(rho2 * _SQRT_HALF)) - rho2 * e2 + rho1 * e1) * wts  # erfc: no tail cancellation
+    return prob, (m * dx).sum(-1), (m * dy).sum(-1)
+
+
+def glint_radiance(view_zenith: Any, view_azimuth: Any, slopes: Any, refractive_index: Any, sun: Sun,
+                   shadowing: bool = True, sun_masking: bool = True) -> torch.Tensor:
+    """The reflected sun's contribution to the apparent radiance (Eq. 10 with the sun's disk as the
+    sky) [W m⁻² sr⁻¹ in the irradiance's band] (module docstring).
+
+    Args:
+        view_zenith, view_azimuth: θ̂, φ̂ of the line of sight sea → sensor [rad].
+        slopes: :class:`~roughsea_torch.SlopeStatistics` (shifted statistics allowed).
+        refractive_index: m = n + i k of the sea.
+        sun: :class:`Sun`.
+        shadowing: Eq. 5 (view side) or Eq. 7.
+        sun_masking: Smith's G1 for the sun's direction.
+
+    Returns:
+        R_glint, the broadcast shape, the inputs' dtype and device; 0 for a sun below the horizon.
+    """
+    from .expectation import _denominator, _geometry, _prepare
+    from .optics import _fresnel_terms, split_refractive_index
+
+    dtype, device, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes, refractive_index,
+                                                          sun_zenith=sun.zenith, sun_azimuth=sun.azimuth,
+                                                          sun_irradiance=sun.irradiance)
+    n, k = split_refractive_index(refractive_index, dtype, device)
+    tz, tp = as_tensor(sun.zenith, dtype, device), as_tensor(sun.azimuth, dtype, device)
+    e_sun, alpha = as_tensor(sun.irradiance, dtype, device), as_tensor(sun.radius, dtype, device)
+    zero = torch.zeros((), dtype=dtype, device=device)
+    if mx is None:
+        mx = my = zero
+    ct, st = torch.cos(vz), torch.sin(vz)
+    v = (st * torch.cos(va), st * torch.sin(va), ct)
+    cs, ss = torch.cos(tz), torch.sin(tz)
+    cp, sp = torch.cos(tp), torch.sin(tp)
+    above = cs > 0
+    csp = torch.where(above, cs, torch.ones_like(cs))  # keep the sun's arithmetic finite below the horizon
+    w = (ss * cp, ss * sp, csp)
+    p = tuple(a + b for a, b in zip(v, w))
+    q = p[2]
+    sgx, sgy = p[0] / q, p[1] / q  # the specular slope s_g (facet normal ∝ (s, 1))
+    # the disk's tangent basis at ω_sun and the Jacobian ∂s/∂u (2×2), u the disk's offset [rad]
+    e1 = (csp * cp, csp * sp, -ss)
+    e2 = (-sp, cp, torch.zeros_like(sp))
+    j11, j21 = (e1[0] - sgx * e1[2]) / q, (e1[1] - sgy * e1[2]) / q
+    j12, j22 = (e2[0] - sgx * e2[2]) / q, (e2[1] - sgy * e2[2]) / q
+    # whitened slopes: z = L⁻¹ (s − μ), Σ = L Lᵀ (floors keep a flat sea finite)
+    floor = 1e-24
+    l11 = torch.sqrt(vx.clamp_min(floor))
+    l21 = cxy / l11
+    l22 = torch.sqrt((vy - l21 * l21).clamp_min(floor))
+    cxw = (sgx - mx) / l11
+    cyw = ((sgy - my) - l21 * cxw) / l22
+    # E' = {c + M w : |w| ≤ 1}, M = α L⁻¹ J; K = M⁻ᵀ M⁻¹ = (1/α²) Lᵀ J⁻ᵀ J⁻¹ L
+    det_j = j11 * j22 - j12 * j21
+    i11, i12, i21, i22 = j22 / det_j, -j12 / det_j, -j21 / det_j, j11 / det_j  # J⁻¹
+    # N = J⁻¹ L
+    n11, n12 = i11 * l11 + i12 * l21, i12 * l22
+    n21, n22 = i21 * l11 + i22 * l21, i22 * l22
+    inv_a2 = 1.0 / (alpha * alpha)
+    k11 = (n11 * n11 + n21 * n21) * inv_a2
+    k12 = (n11 * n12 + n21 * n22) * inv_a2
+    k22 = (n12 * n12 + n22 * n22) * inv_a2
+    det_k = (l11 * l22 / (det_j * alpha * alpha)) ** 2  # det K = (det J⁻¹ det L / α²)², from the factors
+    shape = torch.broadcast_shapes(cxw.shape, cyw.shape, k11.shape, k12.shape, k22.shape, det_k.shape)
+    prob, mzx, mzy = _ellipse_probability(*(x.expand(shape) for x in (cxw, cyw, k11, k12, k22, det_k)))
+    # t and ρ at s* = E[s | s ∈ E], the facets that actually mirror the sun: s_g + O(α²) for broad
+    # slopes, the mean slope for a calm sea (a flat sea mirrors the sun with ρ(θ̂), not with the
+    # ρ of the facet that would mirror the disk's centre: O(α tan θ̂) apart)
+    ok = prob > 1e-300
+    ps = torch.where(ok, prob, torch.ones_like(prob))
+    zx = torch.where(ok, mzx / ps, cxw.expand(shape))
+    zy = torch.where(ok, mzy / ps, cyw.expand(shape))
+    s_x = mx + l11 * zx
+    s_y = my + l21 * zx + l22 * zy
+    t_g = ct + st * (s_x * torch.cos(va) + s_y * torch.sin(va))
+    cos_omega = (t_g * torch.rsqrt(1.0 + s_x * s_x + s_y * s_y)).clamp(0.0, 1.0)
+    rs_, rp_, _, _ = _fresnel_terms(cos_omega, n, k)
+    rho = 0.5 * (rs_ + rp_)
+    g = _geometry(vz, va, vx, vy, cxy, mx, my)
+    D = _denominator(g, shadowing)
+    l_sun = e_sun / (4.0 * math.pi * torch.sin(0.5 * alpha) ** 2)  # Ω_sun = 2π(1 − cos α), without cancellation
+    out = rho * t_g * l_sun * prob / D
+    if sun_masking:
+        gs = _geometry(tz.clamp_max(math.pi / 2), tp, vx, vy, cxy, mx, my)
+        d_sun = _denominator(gs, True)
+        e_s = (gs.ct + gs.st * gs.mu).clamp_min(0.0)
+        out = out * (e_s / d_sun.clamp_min(torch.finfo(dtype).tiny)).clamp(0.0, 1.0)
+    return torch.where(above, out, torch.zeros_like(out))
