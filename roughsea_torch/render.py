@@ -95,6 +95,12 @@ class SeaScene:
             image for frames that do not depend on how a batch is split.
         time_s: time of the realization [s], float or (B,); waves move by their dispersion
             relation, so one seed at successive times is a coherent clip.
+        sun: ``None`` (default, night or an overcast sun) or a :class:`~roughsea_torch.sun.Sun`
+            whose ``azimuth`` is a WORLD azimuth [rad] (from +x towards +y, like the camera's yaw)
+            and ``irradiance`` the direct irradiance at the surface in the scene's band [W m⁻²]
+            (fields float or (B,)): its glint is added to the sea pixels (after the path's
+            transmittance); the sky stays the scene's ``sky``. Not yet with ``seed=``.
+        sun_masking: Smith's masking of the facets from the sun's side (default True).
 
     Example:
         >>> scene = SeaScene(wind_speed=torch.tensor([3.0, 12.0]), wind_direction=0.5,
@@ -121,6 +127,8 @@ class SeaScene:
         air_temperature: Any = None,
         seed: Any = None,
         time_s: Any = 0.0,
+        sun: Any = None,
+        sun_masking: bool = True,
     ):
         if (slopes is None) == (wind_speed is None):
             raise ValueError("SeaScene: give exactly one of slopes= or wind_speed=")
@@ -182,6 +190,16 @@ class SeaScene:
                 raise ValueError(f"seed must be None, an int in [0, 2**63) or a sequence of such ints (one per image); got {seed!r}")
             seed = seeds[0] if (isinstance(seed, int)) else seeds
         check_finite_range("time_s", time_s, unit="s")
+        if sun is not None:
+            from .sun import Sun
+
+            if not isinstance(sun, Sun):
+                raise ValueError(f"sun must be None or a roughsea_torch.Sun; got {type(sun).__name__}")
+            if seed is not None:
+                raise ValueError("sun: the glint of textured seas (seed=...) is not implemented yet; "
+                                 "use seed=None (expectation images) with a sun")
+        self.sun = sun
+        self.sun_masking = sun_masking
         self.seed = seed
         self.time_s = time_s
         self._wave_fields: dict[Any, Any] = {}
@@ -654,7 +672,7 @@ def render(
             p_sea = p
             if p["air_scale"] is not None:  # one scaled sky table per image
                 p_sea = dict(p, sky=p["sky"].with_radiance(p["sky"].radiance.to(dtype=dtype, device=device) * p["air_scale"][:, None]))
-            img = (_sea_direct(geom, p_sea, scene, q) if scene.seed is None
+            img = (_sea_direct(geom, p_sea, scene, q, B, dtype, device) if scene.seed is None
                    else _sea_direct_textured(geom, cameras, p_sea, scene, q, B, dtype, device))
             if scene.path is not None:
                 _check_path_altitude(scene.path, altitude)
@@ -679,8 +697,8 @@ def _relative_azimuth(geom: ViewGeometry, p: dict[str, Any]) -> torch.Tensor:
     return geom.view_azimuth - p["wind_direction"][:, None, None]
 
 
-def _sea_direct(geom: ViewGeometry, p: dict[str, Any], scene: SeaScene, q: Quadrature) -> torch.Tensor:
-    B = geom.is_sea.shape[0]
+def _sea_direct(geom: ViewGeometry, p: dict[str, Any], scene: SeaScene, q: Quadrature, B: int, dtype: torch.dtype,
+                device: torch.device) -> torch.Tensor:
     sea = geom.is_sea
     img_idx = torch.arange(B, device=sea.device)[:, None, None].expand_as(sea)[sea]
     th = geom.view_zenith[sea]
@@ -689,10 +707,73 @@ def _sea_direct(geom: ViewGeometry, p: dict[str, Any], scene: SeaScene, q: Quadr
     sky = select_sky(p["sky"], img_idx.cpu())
     vals = apparent_radiance(
         th, ph, slopes, (p["n"][img_idx], p["k"][img_idx]), sea_radiance=p["rb"][img_idx], sky=sky,
-        shadowing=scene.shadowing, quadrature=q,
+        shadowing=scene.shadowing, quadrature=q, sun=_relative_sun(scene, p, B, dtype, device, img_idx),
+        sun_masking=scene.sun_masking,
     )
     out = torch.zeros(sea.shape, dtype=vals.dtype, device=vals.device)
     return out.index_put((sea,), vals)
+
+
+def _relative_sun(scene: SeaScene, p: dict[str, Any], B: int, dtype: torch.dtype, device: torch.device,
+                  idx: torch.Tensor) -> Any:
+    """The scene's sun for the images ``idx`` with its azimuth from each image's upwind axis."""
+    if scene.sun is None:
+        return None
+    from .sun import Sun
+
+    sun = scene.sun
+    z, a, e, r = (per_batch(f"sun {n}", v, B, dtype, device) for n, v in
+                  (("zenith", sun.zenith), ("azimuth", sun.azimuth), ("irradiance", sun.irradiance), ("radius", sun.radius)))
+    return Sun(z[idx], a[idx] - p["wind_direction"][idx], e[idx], r[idx])
+
+
+def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Tensor, dx: torch.Tensor,
+                  dy: torch.Tensor, sea: torch.Tensor, altitude: torch.Tensor, earth_radius_m: float) -> torch.Tensor:
+    """τ · R_glint at the sea pixels of images ``sl`` (b, H, W), 0 elsewhere. Only pixels whose specular
+    slope lies within 9 standard deviations (whitened) of the slope law, plus the disk's own extent,
+    are evaluated: the rest of the image carries less than exp(−40) of the glint's peak."""
+    from .sun import glint_radiance
+
+    b_, H, W = cos_t.shape
+    dtype, device = cos_t.dtype, cos_t.device
+    B = p["vx"].shape[0]
+    idx_all = torch.arange(sl.start, sl.stop, device=device)
+    sun = _relative_sun(scene, p, B, dtype, device, idx_all)
+    with torch.no_grad():  # the mask only
+        ct = cos_t.clamp(0.0, 1.0)
+        st = torch.sqrt((1 - ct * ct).clamp_min(0.0))
+        inv = torch.rsqrt((dx * dx + dy * dy).clamp_min(1e-30))
+        wd = p["wind_direction"][sl, None, None]
+        cw, sw = torch.cos(wd), torch.sin(wd)
+        ex, ey = -dx * inv, -dy * inv  # LOS azimuth (world) → the upwind frame
+        vx_, vy_ = st * (ex * cw + ey * sw), st * (ey * cw - ex * sw)
+        sz, sa = sun.zenith[:, None, None], sun.azimuth[:, None, None]
+        wx, wy, wz = torch.sin(sz) * torch.cos(sa), torch.sin(sz) * torch.sin(sa), torch.cos(sz)
+        qz = ct + wz
+        sgx, sgy = (vx_ + wx) / qz, (vy_ + wy) / qz
+        a2, b2, c2 = (p[k][sl, None, None] for k in ("vx", "vy", "cxy"))
+        det = (a2 * b2 - c2 * c2).clamp_min(1e-30)
+        d2 = (b2 * sgx * sgx - 2 * c2 * sgx * sgy + a2 * sgy * sgy) / det
+        lam_min = (0.5 * (a2 + b2 - torch.sqrt((a2 - b2) ** 2 + 4 * c2 * c2))).clamp_min(1e-24)
+        reach = sun.radius[:, None, None] * 2.0 * (1 + sgx * sgx + sgy * sgy) / qz.clamp_min(1e-6) / torch.sqrt(lam_min)
+        keep = sea & (wz > 0) & (torch.sqrt(d2) - reach < 9.0)
+    out = torch.zeros_like(cos_t)
+    if not bool(keep.any()):
+        return out
+    img = torch.arange(b_, device=device)[:, None, None].expand_as(keep)[keep]
+    c_k = cos_t[keep]
+    phi = torch.atan2(-dy[keep], -dx[keep]) - p["wind_direction"][sl][img]
+    slopes = SlopeStatistics.from_variances(p["vx"][sl][img], p["vy"][sl][img], p["cxy"][sl][img])
+    from .sun import Sun
+
+    s_k = Sun(sun.zenith[img], sun.azimuth[img], sun.irradiance[img], sun.radius[img])
+    g = glint_radiance(torch.acos(c_k.clamp(-1.0, 1.0)), phi, slopes, (p["n"][sl][img], p["k"][sl][img]), s_k,
+                       scene.shadowing, scene.sun_masking)
+    if scene.path is not None:
+        h = altitude[sl].to(dtype)[img]
+        tau, _ = scene.path(h, _slant_range(c_k, h, earth_radius_m), clamp=True)
+        g = g * tau.to(dtype)
+    return out.index_put((keep,), g)
 
 
 def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str, Any], scene: SeaScene,
@@ -776,7 +857,8 @@ def _render_table(
     # a textured sea's clutter depends on the view's azimuth through the resolved waves' anisotropy
     # (and is not even in it): the table then keeps an unfolded azimuth dimension
     textured = scene.seed is not None
-    iso = not textured and bool(((p["vx"] == p["vy"]) & (p["cxy"] == 0)).all())
+    sunny = scene.sun is not None  # the glint is per pixel, and needs the rays' azimuths
+    iso = not (textured or sunny) and bool(((p["vx"] == p["vy"]) & (p["cxy"] == 0)).all())
     # Uncorrelated anisotropic slopes (Cox–Munk): the table runs over the folded azimuth ψ ∈ [0, π/2].
     # R_a is even in φ̂ there, and as a → 0 (or b → 0) it has a kink at φ̂ = 0 (π/2), where the
     # rms slope along the view, √(a² cos²φ̂ + b² sin²φ̂), → b |sin φ̂|: folded, the kink sits at an
@@ -884,7 +966,7 @@ def _render_table(
             sky_rows = _sky_rows(select_sky(p["sky"], sl), air, scene, s_rows, altitude[sl]).to(dtype)
         else:  # no sky work when no pixel sees sky
             sky_rows = torch.zeros(b_, Ms, dtype=dtype, device=device)
-        if brightness and not textured:  # in kelvin at the azimuth nodes, before the azimuth resampling: the
+        if brightness and not (textured or sunny):  # in kelvin at the azimuth nodes, before the azimuth resampling: the
             # brightness temperature is as smooth in azimuth as the radiance, and this costs
             # (M_z + M_s) × nphi conversions an image instead of one a pixel
             sea_rows = _kelvin(sea_rows, scene.band)
@@ -934,7 +1016,10 @@ def _render_table(
             o = _azimuth_coordinate(dx, dy, offset, fold)
             vals = vals + tex.pixels(sl, p, wf, delta, cos_t, zeta, o, dx, dy, sea, lo, span_z, a, b, altitude,
                                      earth_radius_m, eps[sl])
-        if textured and brightness:  # per pixel: the texture is added in radiance
+        if sunny:
+            cos_t = eps[sl, None, None].to(dtype) * torch.sqrt(q_)
+            vals = vals + _glint_pixels(scene, p, sl, cos_t, dx, dy, sea, altitude, earth_radius_m)
+        if (textured or sunny) and brightness:  # per pixel: texture and glint are added in radiance
             vals = _kelvin(vals, scene.band)
         return vals
 
