@@ -150,3 +150,33 @@ def test_shifted_slopes_match_reference(shifted_reference, dtype, rtol):
         for name, g, e in zip(("D", "emissivity", "R_a"), got, expected):
             assert g.dtype == dtype
             assert abs(float(g) - e) <= rtol * abs(e), f"{name} {th_deg}° μ={mu} sh={sh}: {float(g)!r} vs {e!r}"
+
+
+# The reflected sun: (view zenith [deg], view azimuth, (a, b, r), mean, sun zenith [deg], sun azimuth,
+# shadowing, sun masking)
+GLINT = [
+    (60.0, 0.3, (0.15, 0.12, 0.0), (0.0, 0.0), 30.0, 0.3 + math.pi, True, True),
+    (80.0, 0.0, (0.18, 0.14, 0.0), (0.0, 0.0), 75.0, math.pi, True, True),
+    (85.0, 0.2, (0.12, 0.09, 0.3), (0.03, -0.02), 80.0, 0.2 + math.pi, True, True),
+    (70.0, 0.0, (0.02, 0.015, 0.0), (0.0, 0.0), 69.5, math.pi, False, False),
+    (70.0, 0.0, (0.003, 0.003, 0.0), (0.0, 0.0), 70.1, math.pi, True, True),
+    (45.0, 1.0, (0.1, 0.1, 0.0), (0.05, 0.05), 40.0, 1.0 + math.pi, True, False),
+]
+
+
+@pytest.mark.parametrize("dtype, rtol", [(torch.float64, 5e-4), (torch.float32, 5e-4)], ids=["float64", "float32"])
+def test_glint_matches_reference(dtype, rtol):
+    """rs.glint_radiance (ellipse mass about the specular slope, t and ρ at the facets' mean slope)
+    against the reference (nested quadrature over the sun's disk in direction space): broad and calm
+    laws, a shifted mean, shadowing and sun masking on and off. Measured: 1.6e-4 at worst (the
+    linearized disk image and t, ρ taken at one point), both dtypes."""
+    for th, ph, (a, b, r), mu, sz, sa, sh, mask in GLINT:
+        want = float(ref.glint_radiance(math.radians(th), ph, ref.SlopeStatistics(a, b, r), M, math.radians(sz), sa, 10.0,
+                                        shadowing=sh, sun_masking=mask, slope_mean=mu))
+        s = rs.SlopeStatistics(torch.tensor(a, dtype=dtype), torch.tensor(b, dtype=dtype), torch.tensor(r, dtype=dtype))
+        if mu != (0.0, 0.0):
+            s = s.shifted(torch.tensor(mu[0], dtype=dtype), torch.tensor(mu[1], dtype=dtype))
+        got = rs.glint_radiance(torch.tensor(math.radians(th), dtype=dtype), ph, s, M, rs.Sun(math.radians(sz), sa, 10.0),
+                                shadowing=sh, sun_masking=mask)
+        assert got.dtype == dtype
+        assert want > 0 and abs(float(got) / want - 1) <= rtol, (th, sz, a, float(got), want)

@@ -24,12 +24,15 @@ Choices and notes on the paper (see also the docstrings):
 * An rms slope exactly 0 (one axis) is handled as the degenerate line law (facet normals in one
   vertical plane; corr is then irrelevant). Both 0: flat-sea closed form, no quadrature.
   Very strong anisotropy (a/b > ~1e6) loses accuracy (~1e-8) to the rounding of phi.
+* The reflected sun (glint_radiance, module sun): Eq. 10 with R_s = the sun's disk radiance,
+  integrated directly over the disk in direction space (half-vector change of variables).
 """
 
 from .fresnel import fresnel_reflectance
 from .planck import band_radiance, brightness_temperature, planck_radiance
 from .rough_sea import apparent_radiance, emissivity, projected_area
 from .slopes import SlopeStatistics, slope_pdf
+from .sun import glint_radiance, sun_masking_g1, sun_solid_angle
 
 __all__ = [
     "SlopeStatistics",
@@ -41,4 +44,7 @@ __all__ = [
     "planck_radiance",
     "band_radiance",
     "brightness_temperature",
+    "glint_radiance",
+    "sun_masking_g1",
+    "sun_solid_angle",
 ]
