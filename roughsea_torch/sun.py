@@ -100,17 +100,21 @@ def _ellipse_probability(cx: torch.Tensor, cy: torch.Tensor, k11: torch.Tensor, 
     kc1, kc2 = k11 * cx + k12 * cy, k12 * cx + k22 * cy
     c0 = cx * kc1 + cy * kc2 - 1.0
     inside = c0 < 0
-    # the tangents, in the frame of the direction to the centre (both within ±π/2 of it):
-    # (K'₂₂ − det K |c|²) tan²ψ + 2 K'₁₂ tanψ + K'₁₁ = 0, K' = K rotated into (ê_c, ê_c⊥)
-    th_c = torch.atan2(cy, cx)
-    cth, sth = torch.cos(th_c), torch.sin(th_c)
-    r11 = cth * cth * k11 + 2 * cth * sth * k12 + sth * sth * k22
-    r12 = (k22 - k11) * cth * sth + k12 * (cth * cth - sth * sth)
-    r22 = sth * sth * k11 - 2 * cth * sth * k12 + cth * cth * k22 - det_k * (cx * cx + cy * cy)
-    disc = torch.sqrt((r12 * r12 - r11 * r22).clamp_min(0.0))
-    r22s = torch.where(r22 < 0, r22, -torch.ones_like(r22))
-    t1, t2 = torch.atan((-r12 - disc) / r22s), torch.atan((-r12 + disc) / r22s)
-    psi1, psi2 = torch.minimum(t1, t2), torch.maximum(t1, t2)
+    # The rays that meet E' from an outside origin: a − det K (d × c)² ≥ 0, i.e. dᵀ Q d ≥ 0 with
+    # Q = K − det K c⊥c⊥ᵀ (c⊥ = (c_y, −c_x)), indefinite outside. With Q's eigenpairs λ₁ > 0 > λ₂,
+    # u₁, u₂ (u₁ towards c), they are d = cos ψ u₁ + sin ψ u₂, |ψ| ≤ γ = atan √(λ₁ / −λ₂) < π/2; a long
+    # thin E' can reach beyond ±π/2 of the direction to its centre, which this frame allows.
+    dk = det_k
+    q11, q12, q22 = k11 - dk * cy * cy, k12 + dk * cx * cy, k22 - dk * cx * cx
+    qm, qd = 0.5 * (q11 + q22), torch.sqrt((0.5 * (q11 - q22)) ** 2 + q12 * q12)
+    lam1, lam2 = qm + qd, qm - qd
+    phi1 = 0.5 * torch.atan2(2.0 * q12, q11 - q22)
+    phi1 = torch.where(torch.cos(phi1) * cx + torch.sin(phi1) * cy < 0, phi1 + math.pi, phi1)
+    neg = lam2 < 0
+    gamma = torch.where(neg, torch.atan(torch.sqrt(lam1.clamp_min(0.0) / torch.where(neg, -lam2, torch.ones_like(lam2)))),
+                        torch.full_like(lam1, 0.5 * math.pi))
+    th_c = torch.where(inside, torch.zeros_like(phi1), phi1)
+    psi1, psi2 = -gamma, gamma
     x, w = _nodes(_N_RAYS, dtype, device)
     mid, half = 0.5 * (psi1 + psi2), 0.5 * (psi2 - psi1)
     u = torch.sin(0.5 * math.pi * x)

@@ -161,15 +161,19 @@ GLINT = [
     (70.0, 0.0, (0.02, 0.015, 0.0), (0.0, 0.0), 69.5, math.pi, False, False),
     (70.0, 0.0, (0.003, 0.003, 0.0), (0.0, 0.0), 70.1, math.pi, True, True),
     (45.0, 1.0, (0.1, 0.1, 0.0), (0.05, 0.05), 40.0, 1.0 + math.pi, True, False),
+    # sun 5° up, view 86.55° just off its vertical plane: the disk's image is long and thin and the
+    # mean lies outside it, beyond 90° of the rays to its centre (a bug once put P at 1 % of this)
+    (86.5506, math.pi - 8.3e-4, (0.0992, 0.1221, 0.0), (0.0, 0.0), 85.0, 0.0, True, True),
+    (86.5506, math.pi - 0.01, (0.0992, 0.1221, 0.0), (0.0, 0.0), 85.0, 0.0, True, True),
 ]
 
 
-@pytest.mark.parametrize("dtype, rtol", [(torch.float64, 5e-4), (torch.float32, 5e-4)], ids=["float64", "float32"])
+@pytest.mark.parametrize("dtype, rtol", [(torch.float64, 1e-3), (torch.float32, 1e-3)], ids=["float64", "float32"])
 def test_glint_matches_reference(dtype, rtol):
     """rs.glint_radiance (ellipse mass about the specular slope, t and ρ at the facets' mean slope)
     against the reference (nested quadrature over the sun's disk in direction space): broad and calm
-    laws, a shifted mean, shadowing and sun masking on and off. Measured: 1.6e-4 at worst (the
-    linearized disk image and t, ρ taken at one point), both dtypes."""
+    laws, a shifted mean, shadowing and sun masking on and off, a grazing sun. Measured: 4.6e-4 at
+    worst (the linearized disk image and t, ρ taken at one point), both dtypes."""
     for th, ph, (a, b, r), mu, sz, sa, sh, mask in GLINT:
         want = float(ref.glint_radiance(math.radians(th), ph, ref.SlopeStatistics(a, b, r), M, math.radians(sz), sa, 10.0,
                                         shadowing=sh, sun_masking=mask, slope_mean=mu))
