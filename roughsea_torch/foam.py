@@ -1,0 +1,285 @@
+"""Foam (whitecaps): coverage against wind, foam emissivity, foam radiance and the area mixture.
+
+In the mean model (``docs/waves.md`` §6) foam is an area fraction ``f`` of the sea. A pixel sees
+
+    R = (1 − f) R_a + f R_foam                                          (:func:`with_foam`)
+
+with R_a the apparent radiance of the foam-free rough sea (Eq. 10) and
+
+    R_foam = ε_f(θ̂) R_B + (1 − ε_f(θ̂)) E_sky/π                          (:func:`foam_radiance`)
+
+Foam is taken as a nearly diffuse (Lambertian) reflector: its directional-hemispherical
+reflectance 1 − ε_f (Kirchhoff) reflects the cosine-weighted hemispherical mean of the sky
+radiance, E_sky/π = (1/π) ∫ R_s cos θ dω = 2 ∫₀¹ R_s(μ) μ dμ (:func:`sky_hemispherical_mean`).
+If R_s ≡ R_B then R_foam = R_B (second law), whatever ε_f.
+
+Sources and numbers
+-------------------
+Whitecap coverage (:func:`whitecap_fraction`):
+    Monahan, E. C. and O'Muircheartaigh, I. (1980), "Optimal power-law description of oceanic
+    whitecap coverage dependence on wind speed", J. Phys. Oceanogr. 10, 2094–2099:
+    W = 3.84e-6 · U10^3.41 (W a fraction, U10 the wind speed at 10 m [m/s]), the robust
+    (biweight) fit to the combined Monahan 1971 and Toba & Chaen 1973 data. W(10 m/s) = 0.99 %,
+    W(15 m/s) = 3.9 %. Capped at 1 (reached at U10 ≈ 38.7 m/s, far beyond the data, which end
+    near 20 m/s). Not verified against the paper's own text (not reachable here): the
+    coefficients are as quoted, identically, by many secondary sources. Alternatives, not
+    implemented: Monahan & O'Muircheartaigh 1986 (Int. J. Remote Sens. 7, 627–642),
+    W = 2.95e-6 U10^3.52 (sometimes misattributed to 1980); Callaghan et al. 2008 (Geophys. Res.
+    Lett. 35, L23609, piecewise law for 3.7–23.1 m/s); Anguelova & Webster 2006 (J. Geophys.
+    Res. 111, C03017) and Salisbury et al. 2013 (J. Geophys. Res. 118, 6201–6222) document an
+    order-of-magnitude scatter of W at a given U10 (sea temperature, fetch, wind history).
+
+Foam emissivity (:func:`foam_emissivity`), thermal infrared, a measurement:
+    Niclòs, R., Valor, E., Caselles, V., Coll, C. and Sánchez, J. M. (2007), "Foam effect on the
+    sea surface emissivity in the 8–14 µm region", J. Geophys. Res. 112, C12020,
+    doi:10.1029/2007JC004521 (controlled-condition measurements, multichannel radiometer,
+    8–14 µm): the foam effect is negligible at low observation angles, significant above 45°, and
+    the foam minus foam-free emissivity difference is about +0.04 at 65° (slightly band
+    dependent); foam reduces the angular variation of the emissivity.
+    Branch, R. et al. (2016), "Infrared emissivity of seawater and foam at large incidence angles
+    in the 3–14 µm wavelength range" (FTIR, 60°–85°, 3.5–5.5 and 8–14 µm): foam emissivity is
+    higher than water's at every wavelength above 65°; the difference grows with angle to a
+    maximum of 0.23 at 8.9 µm and 85°.
+    Only these summary numbers could be checked (the papers' abstracts); the angle-resolved
+    tables were not reachable. The model is therefore the measured DIFFERENCE added to the
+    flat-water Fresnel emissivity ε_w(θ̂) of the same band:
+
+        ε_f(θ̂) = min(1, ε_w(θ̂) + Δ(θ̂)),
+        Δ piecewise linear in θ̂ [deg] through (0, 0), (45, 0), (65, 0.04)   (Niclòs et al. 2007)
+        and continued with the same slope (0.002 per degree) to 0.09 at 90° (an extrapolation).
+
+    Above 65° this is an extrapolation and probably an under-estimate (Branch et al. report up
+    to 0.23 spectrally at 85°). The same Δ is used in the 3–5 µm band: unverified beyond the
+    sign (Branch et al.: foam higher than water at all wavelengths above 65°).
+    ε_w uses one refractive index per band (default: Hale & Querry at 10 µm, 1.218 + 0.0508i,
+    for bands centred in 7–15 µm, the default of ``apparent_radiance``; at 4 µm, 1.351 + 0.0046i,
+    for bands centred in 2.5–6 µm); pass ``refractive_index`` (e.g. from
+    :func:`~roughsea_torch.optics.band_refractive_index`) to use the one given to Eq. 10.
+
+Left out: foam is a patch of the mean plane (its slopes are not those of the waves): no
+shadowing of foam, no foam on the sky-reflection weights of Eq. 10, no multiple reflection
+between foam and water, no foam temperature different from the sea's, no spray. In a textured
+image foam belongs on breaking crests; here it is an area fraction.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+from typing import Any, Callable
+
+import numpy as np
+import torch
+
+from ._validation import as_tensor, check_finite_range, resolve_dtype_device
+from .optics import fresnel_emissivity
+from .radiometry import LWIR, MWIR, as_band
+
+__all__ = [
+    "MONAHAN_COEFFICIENT",
+    "MONAHAN_EXPONENT",
+    "FOAM_EMISSIVITY_EXCESS",
+    "whitecap_fraction",
+    "foam_emissivity",
+    "foam_radiance",
+    "sky_hemispherical_mean",
+    "with_foam",
+]
+
+MONAHAN_COEFFICIENT = 3.84e-6  # Monahan & O'Muircheartaigh 1980, W = a U10^b (fraction, U10 in m/s)
+MONAHAN_EXPONENT = 3.41
+
+# Foam minus foam-free emissivity Δ(θ̂) [(deg, Δ)], 8–14 µm, Niclòs et al. 2007 (the last point is
+# the extrapolation of their 45°–65° slope to 90°, see the module docstring).
+FOAM_EMISSIVITY_EXCESS = ((0.0, 0.0), (45.0, 0.0), (65.0, 0.04), (90.0, 0.09))
+
+_LWIR_INDEX = 1.218 + 0.0508j  # Hale & Querry 1973, 10 µm
+_MWIR_INDEX = 1.351 + 0.0046j  # Hale & Querry 1973, 4 µm
+
+
+def whitecap_fraction(wind_speed: Any) -> torch.Tensor:
+    """Fraction of the sea covered by whitecaps, W = min(1, 3.84e-6 · U10^3.41).
+
+    Monahan & O'Muircheartaigh (1980), J. Phys. Oceanogr. 10, 2094–2099.
+
+    Args:
+        wind_speed: U10, wind speed at 10 m [m/s], finite and ≥ 0; float or tensor.
+
+    Returns:
+        W in [0, 1], the shape of ``wind_speed``; 0 at zero wind, differentiable in the wind
+        (dW/dU = 0 at U = 0 and above the cap, U10 ≈ 38.7 m/s).
+    """
+    check_finite_range("wind_speed", wind_speed, 0.0, math.inf, hi_open=True, unit="m/s")
+    dtype, device = resolve_dtype_device(wind_speed=wind_speed)
+    u = as_tensor(wind_speed, dtype, device)
+    return torch.clamp(MONAHAN_COEFFICIENT * u.pow(MONAHAN_EXPONENT), max=1.0)
+
+
+def _band_index(band: Any) -> complex:
+    """Default refractive index of water for a band, from the band's centre wavelength."""
+    b = as_band(band)
+    centre = 0.5 * (b.lo + b.hi)
+    if 7e-6 <= centre <= 15e-6:
+        return _LWIR_INDEX
+    if 2.5e-6 <= centre <= 6e-6:
+        return _MWIR_INDEX
+    raise ValueError(
+        f"band: foam emissivity is measured in the thermal infrared only; the band centre must lie in "
+        f"[2.5e-6, 6e-6] m (MWIR) or [7e-6, 15e-6] m (LWIR), got {centre!r} m"
+    )
+
+
+@lru_cache(maxsize=8)
+def _excess_table(dtype: torch.dtype, device: str) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    x = torch.tensor([math.radians(a) for a, _ in FOAM_EMISSIVITY_EXCESS], dtype=torch.float64)
+    y = torch.tensor([d for _, d in FOAM_EMISSIVITY_EXCESS], dtype=torch.float64)
+    slope = (y[1:] - y[:-1]) / (x[1:] - x[:-1])
+    return tuple(t.to(dtype=dtype, device=device) for t in (x, y, slope))  # type: ignore[return-value]
+
+
+def _emissivity_excess(theta: torch.Tensor) -> torch.Tensor:
+    """Δ(θ̂): piecewise-linear interpolation of :data:`FOAM_EMISSIVITY_EXCESS` (θ̂ in radians)."""
+    x, y, slope = _excess_table(theta.dtype, str(theta.device))
+    i = torch.bucketize(theta.detach(), x[1:-1], right=True)  # interval index in [0, len(x) − 2]
+    return y[i] + slope[i] * (theta - x[i])
+
+
+def foam_emissivity(view_zenith: Any, band: Any = LWIR, refractive_index: Any = None) -> torch.Tensor:
+    """Directional emissivity of foam ε_f(θ̂) in a thermal-infrared band [dimensionless].
+
+    ε_f = min(1, ε_w(θ̂) + Δ(θ̂)): the flat-water Fresnel emissivity plus the measured foam excess
+    Δ (Niclòs et al. 2007: 0 up to 45°, +0.04 at 65°; linear beyond, see the module docstring).
+
+    Args:
+        view_zenith: θ̂ [rad] in [0, π/2], zenith angle of the line of sight.
+        band: (λ_lo, λ_hi) [m] or a ``SpectralBand`` centred in the MWIR (2.5–6 µm) or LWIR
+            (7–15 µm); it chooses the default refractive index.
+        refractive_index: water index m = n + ik for ε_w; None = the band's default.
+
+    Returns:
+        ε_f in [0, 1], the broadcast shape of the inputs.
+    """
+    check_finite_range("view_zenith", view_zenith, 0.0, math.pi / 2, unit="rad")
+    m = _band_index(band) if refractive_index is None else refractive_index
+    dtype, device = resolve_dtype_device(view_zenith=view_zenith, refractive_index=m)
+    theta = as_tensor(view_zenith, dtype, device)
+    eps_w = fresnel_emissivity(torch.cos(theta), m)
+    if isinstance(m, torch.Tensor):
+        eps_w = eps_w.to(dtype)
+    return torch.clamp(eps_w + _emissivity_excess(theta), max=1.0)
+
+
+def foam_radiance(
+    view_zenith: Any,
+    band: Any,
+    sea_radiance: Any,
+    sky_irradiance_over_pi: Any,
+    refractive_index: Any = None,
+) -> torch.Tensor:
+    """Radiance of a foam patch, R_foam = ε_f R_B + (1 − ε_f) E_sky/π [W m⁻² sr⁻¹].
+
+    Args:
+        view_zenith: θ̂ [rad] in [0, π/2].
+        band: the sensor band (see :func:`foam_emissivity`).
+        sea_radiance: R_B, blackbody band radiance at the sea (foam) temperature [W m⁻² sr⁻¹], ≥ 0.
+        sky_irradiance_over_pi: E_sky/π, the cosine-weighted hemispherical mean of the sky radiance
+            [W m⁻² sr⁻¹], ≥ 0 (:func:`sky_hemispherical_mean`).
+        refractive_index: see :func:`foam_emissivity`.
+
+    Returns:
+        R_foam, the broadcast shape of the inputs.
+    """
+    check_finite_range("sea_radiance", sea_radiance, 0.0, math.inf, hi_open=True, unit="W m-2 sr-1")
+    check_finite_range(
+        "sky_irradiance_over_pi", sky_irradiance_over_pi, 0.0, math.inf, hi_open=True, unit="W m-2 sr-1"
+    )
+    dtype, device = resolve_dtype_device(
+        view_zenith=view_zenith, sea_radiance=sea_radiance, sky_irradiance_over_pi=sky_irradiance_over_pi
+    )
+    eps = foam_emissivity(view_zenith, band, refractive_index).to(dtype=dtype, device=device)
+    rb = as_tensor(sea_radiance, dtype, device)
+    es = as_tensor(sky_irradiance_over_pi, dtype, device)
+    # Written as E + ε (R_B − E): exactly R_B when E = R_B.
+    return es + eps * (rb - es)
+
+
+@lru_cache(maxsize=16)
+def _gauss_legendre_unit(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes μᵢ and weights of 2 ∫₀¹ g(μ) μ dμ ≈ Σ wᵢ g(μᵢ) (Gauss–Legendre on [0, 1])."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    mu = 0.5 * (x + 1.0)
+    return mu, w * mu  # 2 · (w/2) · μ
+
+
+def sky_hemispherical_mean(
+    sky: Any,
+    n: int = 64,
+    dtype: torch.dtype | None = None,
+    device: Any = None,
+) -> torch.Tensor:
+    """Cosine-weighted hemispherical mean of the sky radiance, E_sky/π [W m⁻² sr⁻¹].
+
+    E_sky/π = (1/π) ∫ R_s(θ) cos θ dω = 2 ∫₀¹ R_s(μ) μ dμ (μ = cos θ, azimuthally uniform sky),
+    by n-point Gauss–Legendre in μ on [0, 1] (exact for R_s polynomial in μ of degree ≤ 2n − 2).
+
+    Args:
+        sky: R_s as a callable of cos(zenith) (receives a tensor of shape (n,), returns (..., n)),
+            a constant (float or tensor, returned as is: its mean is itself), or any form
+            :func:`~roughsea_torch.sky.as_sky` accepts (table, named atmosphere).
+        n: number of nodes, ≥ 1.
+        dtype, device: of the nodes given to a callable sky (default ``torch.get_default_dtype()``
+            and CPU); for a float constant, of the result.
+
+    Returns:
+        E_sky/π: the shape of a constant sky, or the leading shape (...) of a callable's output.
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ValueError(f"n must be an integer ≥ 1, got {n!r}")
+    if isinstance(sky, (int, float, np.ndarray, np.generic, torch.Tensor)) and not isinstance(sky, bool):
+        check_finite_range("sky", sky, 0.0, math.inf, hi_open=True, unit="W m-2 sr-1")
+        dt, dev = resolve_dtype_device(sky=sky)
+        if not isinstance(sky, torch.Tensor):
+            dt = dtype if dtype is not None else dt
+            dev = torch.device(device) if device is not None else dev
+        return as_tensor(sky, dt, dev)
+    if sky is None:
+        raise ValueError("sky is required: a callable of cos(zenith), a (zenith, radiance) table or a constant")
+    if not callable(sky):
+        from .sky import as_sky
+
+        sky = as_sky(sky)
+    dt = dtype if dtype is not None else torch.get_default_dtype()
+    if dt not in (torch.float32, torch.float64):
+        raise ValueError(f"dtype must be torch.float32 or torch.float64, got {dt}")
+    dev = torch.device(device) if device is not None else torch.device("cpu")
+    mu_np, w_np = _gauss_legendre_unit(int(n))
+    mu = torch.as_tensor(mu_np, dtype=dt, device=dev)
+    w = torch.as_tensor(w_np, dtype=dt, device=dev)
+    r = torch.as_tensor(sky(mu))
+    if r.shape[-1:] != (int(n),):
+        r = r.expand(*r.shape[:-1], int(n)) if r.ndim and r.shape[-1] == 1 else r.expand(int(n))
+    return (r * w.to(r.dtype)).sum(-1)
+
+
+def with_foam(apparent_radiance: Any, foam_fraction: Any, foam_radiance: Any) -> torch.Tensor:
+    """Area-fraction mixture R = (1 − f) R_a + f R_foam [W m⁻² sr⁻¹].
+
+    Args:
+        apparent_radiance: R_a of the foam-free sea (Eq. 10) [W m⁻² sr⁻¹], finite and ≥ 0.
+        foam_fraction: f in [0, 1] (e.g. :func:`whitecap_fraction`).
+        foam_radiance: R_foam [W m⁻² sr⁻¹], finite and ≥ 0 (:func:`foam_radiance`).
+
+    Returns:
+        R, the broadcast shape of the inputs; f = 0 gives R_a exactly and f = 1 gives R_foam.
+    """
+    check_finite_range("apparent_radiance", apparent_radiance, 0.0, math.inf, hi_open=True, unit="W m-2 sr-1")
+    check_finite_range("foam_fraction", foam_fraction, 0.0, 1.0)
+    check_finite_range("foam_radiance", foam_radiance, 0.0, math.inf, hi_open=True, unit="W m-2 sr-1")
+    dtype, device = resolve_dtype_device(
+        apparent_radiance=apparent_radiance, foam_fraction=foam_fraction, foam_radiance=foam_radiance
+    )
+    ra = as_tensor(apparent_radiance, dtype, device)
+    f = as_tensor(foam_fraction, dtype, device)
+    rf = as_tensor(foam_radiance, dtype, device)
+    # Written as the two weights: exactly R_a at f = 0 and exactly R_foam at f = 1.
+    return (1.0 - f) * ra + f * rf
