@@ -316,7 +316,8 @@ class TextureTable:
                zeta: torch.Tensor, o: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, sea: torch.Tensor,
                lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, altitude: torch.Tensor,
                earth_radius_m: float, eps: torch.Tensor) -> torch.Tensor:
-        """The texture of every pixel of images ``sl`` (0 off the sea), (b, H, W)."""
+        """The texture of every pixel of images ``sl`` (0 off the sea), (b, H, W); and each pixel's
+        flat-point quantile x and resolved covariance (world frame), for the glint."""
         import torch.nn.functional as F
 
         from .render import _slant_range
@@ -347,7 +348,8 @@ class TextureTable:
         gx = (2.0 * (o - a_) / (b2 - a_) - 1.0) / (1.0 + self.ea)
         grid = torch.stack([gx, gy, gz], -1)[:, None]  # (b, 1, H, W, 3): x → W (azimuth), y → H (ζ), z → D (x)
         out = F.grid_sample(vol[:, None], grid, mode="bilinear", padding_mode="border", align_corners=True)[:, 0, 0]
-        return torch.where(sea, out, torch.zeros_like(out))
+        # x and the resolved covariance go back too: the glint of the same realization needs them
+        return torch.where(sea, out, torch.zeros_like(out)), x, (cov[:, 0], cov[:, 1], cov[:, 2])
 
 
 def sky_of_chunk(sky: Any, b: int) -> Any:

@@ -554,6 +554,7 @@ def apparent_radiance(
     quadrature: Quadrature | None = None,
     sun: Any = None,
     sun_masking: bool = True,
+    foam_fraction: Any = None,
 ) -> torch.Tensor:
     """Apparent radiance of the rough sea, Eq. 10 [W m⁻² sr⁻¹ (units of the radiances given)].
 
@@ -574,6 +575,9 @@ def apparent_radiance(
             :class:`~roughsea_torch.sun.Sun`: its reflection off the waves (the glint,
             :func:`~roughsea_torch.sun.glint_radiance`) is added; ``sky`` is then the rest of the sky.
         sun_masking: with a sun, Smith's masking of the facets from the sun's side (default True).
+        foam_fraction: ``None`` (default, no foam) or the whitecap fraction f in [0, 1] (e.g.
+            :func:`~roughsea_torch.foam.whitecap_fraction` of the wind): (1 − f) R_a + f R_foam,
+            R_foam = ε_f R_B + (1 − ε_f) E_sky/π (:mod:`roughsea_torch.foam`).
 
     Returns:
         R_a, the broadcast shape of the inputs (including a batched sky's leading dims).
@@ -598,6 +602,15 @@ def apparent_radiance(
         if not isinstance(sun, Sun):
             raise ValueError(f"sun must be None or a roughsea_torch.Sun; got {type(sun).__name__}")
         out = out + glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun, shadowing, sun_masking)
+    if foam_fraction is not None:
+        from .foam import foam_radiance, sky_hemispherical_mean, with_foam
+        from .radiometry import LWIR
+
+        check_finite_range("foam_fraction", foam_fraction, 0.0, 1.0)
+        e_sky = sky_hemispherical_mean(as_sky(sky), dtype=out.dtype, device=out.device)
+        rf = foam_radiance(as_tensor(view_zenith, out.dtype, out.device), LWIR, rb.to(out.dtype), e_sky,
+                           refractive_index=refractive_index)
+        out = with_foam(out, as_tensor(foam_fraction, out.dtype, out.device), rf)
     return out
 
 

@@ -99,8 +99,19 @@ class SeaScene:
             whose ``azimuth`` is a WORLD azimuth [rad] (from +x towards +y, like the camera's yaw)
             and ``irradiance`` the direct irradiance at the surface in the scene's band [W m⁻²]
             (fields float or (B,)): its glint is added to the sea pixels (after the path's
-            transmittance); the sky stays the scene's ``sky``. Not yet with ``seed=``.
+            transmittance); the sky stays the scene's ``sky``. On textured seas each pixel's glint is
+            that of its own unresolved slopes about its resolved slope.
+        sun_zenith, sun_azimuth: instead of ``sun=``, the sun's apparent zenith [rad] and world azimuth
+            [rad] (floats or (B,)); its direct irradiance then comes from the shipped LOWTRAN7 table
+            of the named atmosphere in the scene's band (:func:`roughsea_torch.solar.load_solar_irradiance`;
+            a named ``sky`` is needed). :func:`roughsea_torch.solar.sun_position` gives them from a
+            date, time and place (pvlib); note its azimuth is from north, clockwise.
         sun_masking: Smith's masking of the facets from the sun's side (default True).
+        foam: the whitecap fraction of the sea surface: ``"auto"`` (default: Monahan &
+            O'Muircheartaigh's (1980) law at ``wind_speed``, for thermal-infrared bands; none with
+            ``slopes=`` or another band), a number or (B,) tensor in [0, 1], or ``False``. Foam is an
+            area fraction of nearly diffuse, more emissive surface (:mod:`roughsea_torch.foam`):
+            pixel = (1 − f) · sea + f · foam; it takes a share f of the texture and the glint too.
 
     Example:
         >>> scene = SeaScene(wind_speed=torch.tensor([3.0, 12.0]), wind_direction=0.5,
@@ -128,7 +139,10 @@ class SeaScene:
         seed: Any = None,
         time_s: Any = 0.0,
         sun: Any = None,
+        sun_zenith: Any = None,
+        sun_azimuth: Any = 0.0,
         sun_masking: bool = True,
+        foam: Any = "auto",
     ):
         if (slopes is None) == (wind_speed is None):
             raise ValueError("SeaScene: give exactly one of slopes= or wind_speed=")
@@ -195,14 +209,50 @@ class SeaScene:
 
             if not isinstance(sun, Sun):
                 raise ValueError(f"sun must be None or a roughsea_torch.Sun; got {type(sun).__name__}")
-            if seed is not None:
-                raise ValueError("sun: the glint of textured seas (seed=...) is not implemented yet; "
-                                 "use seed=None (expectation images) with a sun")
-        self.sun = sun
+        if sun_zenith is not None:
+            if sun is not None:
+                raise ValueError("SeaScene: give sun= or sun_zenith= (with sun_azimuth=), not both")
+            if self.atmosphere is None:
+                raise ValueError("sun_zenith: the sun's irradiance comes from a named atmosphere's LOWTRAN7 table; "
+                                 "give sky='<name>', or sun=rs.Sun(zenith, azimuth, irradiance) with your own irradiance")
+            check_finite_range("sun_zenith", sun_zenith, 0.0, math.pi, unit="rad")
+            check_finite_range("sun_azimuth", sun_azimuth, unit="rad")
+        self._sun = sun
+        self.sun_zenith, self.sun_azimuth = sun_zenith, sun_azimuth
         self.sun_masking = sun_masking
+        if foam is None or foam is False:
+            foam = None
+        elif isinstance(foam, str):
+            if foam != "auto":
+                raise ValueError(f"foam must be 'auto', False or a fraction in [0, 1]; got {foam!r}")
+        else:
+            check_finite_range("foam", foam, 0.0, 1.0)
+        self.foam = foam
         self.seed = seed
         self.time_s = time_s
         self._wave_fields: dict[Any, Any] = {}
+
+    @property
+    def sun(self) -> Any:
+        """The scene's :class:`~roughsea_torch.sun.Sun` (world azimuth), or None: the one given, or one
+        at ``sun_zenith``/``sun_azimuth`` with the named atmosphere's LOWTRAN7 direct irradiance in
+        the scene's band (read each time, so it follows the scene's current fields)."""
+        if self._sun is not None or self.sun_zenith is None:
+            return self._sun
+        from .solar import load_solar_irradiance
+        from .sun import Sun
+
+        e = load_solar_irradiance(self.atmosphere, (self.band.lo, self.band.hi), self.band.response)
+        z = self.sun_zenith
+        zt = z.double() if isinstance(z, torch.Tensor) else torch.tensor(float(z), dtype=torch.float64)
+        irr = e(zt)
+        if isinstance(z, torch.Tensor):
+            irr = irr.to(z.dtype)
+        return Sun(z, self.sun_azimuth, irr if isinstance(z, torch.Tensor) else float(irr))
+
+    @sun.setter
+    def sun(self, value: Any) -> None:
+        self._sun, self.sun_zenith = value, None
 
     @property
     def observer_sky(self) -> Any:
@@ -290,7 +340,18 @@ class SeaScene:
         # "sky" is the atmosphere's own; R_a is linear in the sky radiance, so the renderer
         # scales the reflected-sky term T_s and the sky pixels by air_scale instead of
         # interpolating one scaled sky table per image
-        return dict(vx=vx, vy=vy, cxy=cxy, wind_direction=wd, rb=rb, n=n.expand(B), k=k.expand(B), sky=self.sky,
+        foam = None
+        if self.foam == "auto":
+            centre = 0.5 * (self.band.lo + self.band.hi)
+            if self.wind_speed is not None and (2.5e-6 <= centre <= 6e-6 or 7e-6 <= centre <= 15e-6):
+                from .foam import whitecap_fraction
+
+                foam = whitecap_fraction(per_batch("wind_speed", self.wind_speed, B, dtype, device))
+        elif self.foam is not None:
+            foam = per_batch("foam", self.foam, B, dtype, device)
+        if foam is not None and not bool((foam > 0).any()):
+            foam = None  # no foam anywhere: leave it out
+        return dict(vx=vx, vy=vy, cxy=cxy, wind_direction=wd, rb=rb, n=n.expand(B), k=k.expand(B), sky=self.sky, foam=foam,
                     air_scale=air_scale)
 
 
@@ -671,7 +732,8 @@ def render(
         if bool(sea.any()):
             p_sea = p
             if p["air_scale"] is not None:  # one scaled sky table per image
-                p_sea = dict(p, sky=p["sky"].with_radiance(p["sky"].radiance.to(dtype=dtype, device=device) * p["air_scale"][:, None]))
+                p_sea = dict(p, sky=p["sky"].with_radiance(p["sky"].radiance.to(dtype=dtype, device=device) * p["air_scale"][:, None]),
+                             air_scale=None)  # the sky itself now carries it
             img = (_sea_direct(geom, p_sea, scene, q, B, dtype, device) if scene.seed is None
                    else _sea_direct_textured(geom, cameras, p_sea, scene, q, B, dtype, device))
             if scene.path is not None:
@@ -710,8 +772,33 @@ def _sea_direct(geom: ViewGeometry, p: dict[str, Any], scene: SeaScene, q: Quadr
         shadowing=scene.shadowing, quadrature=q, sun=_relative_sun(scene, p, B, dtype, device, img_idx),
         sun_masking=scene.sun_masking,
     )
+    if p["foam"] is not None:
+        vals = _foam_mix(vals, th, p, img_idx, scene)
     out = torch.zeros(sea.shape, dtype=vals.dtype, device=vals.device)
     return out.index_put((sea,), vals)
+
+
+def _foam_radiance(theta: torch.Tensor, p: dict[str, Any], idx: Any, scene: SeaScene) -> torch.Tensor:
+    """R_foam(θ̂) = ε_f R_B + (1 − ε_f) E_sky/π for the images ``idx`` (an index tensor per element of
+    θ̂, or a slice with a leading image axis on θ̂)."""
+    from .foam import foam_radiance, sky_hemispherical_mean
+
+    dtype, device = theta.dtype, theta.device
+    sky = select_sky(p["sky"], idx.cpu() if isinstance(idx, torch.Tensor) else idx)
+    e_sky = torch.as_tensor(sky_hemispherical_mean(sky, dtype=dtype, device=device), dtype=dtype, device=device)
+    if p["air_scale"] is not None:
+        e_sky = e_sky * p["air_scale"][idx].to(dtype)
+    extra = (None,) * (theta.ndim - 1) if not isinstance(idx, torch.Tensor) else ()
+    if e_sky.ndim:
+        e_sky = e_sky[(...,) + extra]
+    return foam_radiance(theta, scene.band, p["rb"][idx][(...,) + extra].to(dtype), e_sky,
+                         refractive_index=(p["n"][idx][(...,) + extra], p["k"][idx][(...,) + extra])).to(dtype)
+
+
+def _foam_mix(values: torch.Tensor, theta: torch.Tensor, p: dict[str, Any], idx: torch.Tensor, scene: SeaScene) -> torch.Tensor:
+    """(1 − f) · values + f · R_foam(θ̂), per element (``idx`` the image of each element)."""
+    f = p["foam"][idx].to(values.dtype)
+    return values + f * (_foam_radiance(theta, p, idx, scene) - values)
 
 
 def _relative_sun(scene: SeaScene, p: dict[str, Any], B: int, dtype: torch.dtype, device: torch.device,
@@ -728,10 +815,14 @@ def _relative_sun(scene: SeaScene, p: dict[str, Any], B: int, dtype: torch.dtype
 
 
 def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Tensor, dx: torch.Tensor,
-                  dy: torch.Tensor, sea: torch.Tensor, altitude: torch.Tensor, earth_radius_m: float) -> torch.Tensor:
+                  dy: torch.Tensor, sea: torch.Tensor, altitude: torch.Tensor, earth_radius_m: float,
+                  resolved: tuple | None = None) -> torch.Tensor:
     """τ · R_glint at the sea pixels of images ``sl`` (b, H, W), 0 elsewhere. Only pixels whose specular
     slope lies within 9 standard deviations (whitened) of the slope law, plus the disk's own extent,
-    are evaluated: the rest of the image carries less than exp(−40) of the glint's peak."""
+    are evaluated: the rest of the image carries less than exp(−40) of the glint's peak. On a
+    textured sea (``resolved`` = each pixel's flat-point quantile x and resolved covariance) the glint
+    is that of the pixel's own unresolved Gaussian about its visible resolved slope, as the sky's
+    reflection is (:mod:`roughsea_torch.clutter`), so its ensemble mean is the expectation's glint."""
     from .sun import glint_radiance
 
     b_, H, W = cos_t.shape
@@ -764,11 +855,29 @@ def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Te
     c_k = cos_t[keep]
     phi = torch.atan2(-dy[keep], -dx[keep]) - p["wind_direction"][sl][img]
     slopes = SlopeStatistics.from_variances(p["vx"][sl][img], p["vy"][sl][img], p["cxy"][sl][img])
-    from .sun import Sun
+    from .sun import Sun, sun_masking_factor
 
     s_k = Sun(sun.zenith[img], sun.azimuth[img], sun.irradiance[img], sun.radius[img])
+    masking = scene.sun_masking
+    if resolved is not None:
+        # the sun is masked by all the waves: the G1 of the total law (see sun_masking_factor)
+        g1 = sun_masking_factor(slopes, s_k, dtype, device) if masking else None
+        masking = False
+        from .clutter import along_view, unresolved_statistics, visible_slope
+
+        x_k = resolved[0][keep]
+        inv = torch.rsqrt((dx[keep] ** 2 + dy[keep] ** 2).clamp_min(1e-30))
+        var_a, kap = along_view(tuple(c[keep] for c in resolved[1]), -dx[keep] * inv, -dy[keep] * inv)
+        vx_, vy_, cxy_ = slopes.var_upwind, slopes.var_crosswind, slopes.cov
+        cph, sph = torch.cos(phi), torch.sin(phi)
+        sig_u = torch.sqrt((vx_ * cph * cph + 2 * cxy_ * cph * sph + vy_ * sph * sph - var_a).clamp_min(1e-30))
+        ap = visible_slope(x_k[:, None], c_k, torch.sqrt((1 - c_k * c_k).clamp_min(0.0)),
+                           torch.sqrt(var_a.clamp_min(1e-30)), sig_u)[:, 0]
+        slopes = unresolved_statistics(vx_, vy_, cxy_, phi, var_a, kap, ap)
     g = glint_radiance(torch.acos(c_k.clamp(-1.0, 1.0)), phi, slopes, (p["n"][sl][img], p["k"][sl][img]), s_k,
-                       scene.shadowing, scene.sun_masking)
+                       scene.shadowing, masking)
+    if resolved is not None and g1 is not None:
+        g = g * g1
     if scene.path is not None:
         h = altitude[sl].to(dtype)[img]
         tau, _ = scene.path(h, _slant_range(c_k, h, earth_radius_m), clamp=True)
@@ -806,6 +915,16 @@ def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str
     slopes = unresolved_statistics(vx, vy, cxy, ph, va_, kp_, ap)
     vals = apparent_radiance(th, ph, slopes, (p["n"][img_idx], p["k"][img_idx]), sea_radiance=p["rb"][img_idx],
                              sky=select_sky(p["sky"], img_idx.cpu()), shadowing=scene.shadowing, quadrature=q)
+    sun = _relative_sun(scene, p, B, dtype, device, img_idx)
+    if sun is not None:  # the pixel's own glint, masked from the sun by the total law (sun_masking_factor)
+        from .sun import glint_radiance, sun_masking_factor
+
+        g = glint_radiance(th, ph, slopes, (p["n"][img_idx], p["k"][img_idx]), sun, scene.shadowing, False)
+        if scene.sun_masking:
+            g = g * sun_masking_factor(SlopeStatistics.from_variances(vx, vy, cxy), sun, dtype, device)
+        vals = vals + g
+    if p["foam"] is not None:
+        vals = _foam_mix(vals, th, p, img_idx, scene)
     out = torch.zeros(sea.shape, dtype=vals.dtype, device=vals.device)
     return out.index_put((sea,), vals)
 
@@ -938,6 +1057,8 @@ def _render_table(
             wf = tex.field(sl, p)
             delta = tex.node_delta(sl, p, wf, ph_nodes, sky, scene, q, altitude,
                                    earth_radius_m, eps[sl], lo, span_z)
+            if delta is not None and p["foam"] is not None:  # foam covers f of the waves
+                delta = delta * (1.0 - p["foam"][sl].to(dtype))[:, None, None, None]
 
         # ---- the fine tables: sea rows [τ L_z | L_path] · [R_a ; 1] · L_oᵀ at ζ = lo + span (y_z + 1)/2,
         # sky rows at cos = s0 + j ds (a ray at the horizontal, cos = 0, where a sea-level sky is
@@ -952,6 +1073,15 @@ def _render_table(
                 [coarse, torch.ones(b_, 1, nphi, dtype=dtype, device=device)], 1)
         else:
             sea_rows = Lz_t @ coarse  # (b, M_z, nphi)
+        if p["foam"] is not None:
+            # whitecaps, an area fraction f: (1 − f) · sea + f · foam, the foam exact on every fine row
+            # (its emissivity has kinks in θ̂ that the nodes would smooth), through the same path
+            cos_f = (eps[sl, None] * torch.sinh(lo[:, None] + span_z[:, None] * (y_z + 1) / 2)).clamp(0.0, 1.0).to(dtype)
+            foam_rows = _foam_radiance(torch.acos(cos_f), p, sl, scene)
+            if scene.path is not None:
+                foam_rows = tau.to(dtype) * foam_rows + l_path.to(dtype)
+            f = p["foam"][sl].to(dtype)[:, None, None]
+            sea_rows = sea_rows + f * (foam_rows[:, :, None] - sea_rows)
         s_lo, s_hi = (torch.where(rg.any_sky, v, torch.full_like(v, d)) for v, d in zip(rg.sky, (0.0, 1.0)))
         s_pad = torch.clamp(1e-6 * (s_hi - s_lo), min=1e-7)
         s_lo, s_hi = s_lo - s_pad, s_hi + s_pad
@@ -1011,14 +1141,20 @@ def _render_table(
         # only to first order; bilinear on the fine table is second order (~1e-7 at 4096 rows).
         vals = F.grid_sample(fine[:, None], torch.stack([gx, gy], -1), mode="bilinear", padding_mode="border",
                              align_corners=True)[:, 0]
+        resolved = None
         if textured and delta is not None:
             cos_t = eps[sl, None, None].to(dtype) * torch.sqrt(q_)
             o = _azimuth_coordinate(dx, dy, offset, fold)
-            vals = vals + tex.pixels(sl, p, wf, delta, cos_t, zeta, o, dx, dy, sea, lo, span_z, a, b, altitude,
-                                     earth_radius_m, eps[sl])
+            texture, x_pix, cov_pix = tex.pixels(sl, p, wf, delta, cos_t, zeta, o, dx, dy, sea, lo, span_z, a, b,
+                                                 altitude, earth_radius_m, eps[sl])
+            vals = vals + texture
+            resolved = (x_pix, cov_pix)
         if sunny:
             cos_t = eps[sl, None, None].to(dtype) * torch.sqrt(q_)
-            vals = vals + _glint_pixels(scene, p, sl, cos_t, dx, dy, sea, altitude, earth_radius_m)
+            glint = _glint_pixels(scene, p, sl, cos_t, dx, dy, sea, altitude, earth_radius_m, resolved)
+            if p["foam"] is not None:
+                glint = glint * (1.0 - p["foam"][sl].to(dtype))[:, None, None]
+            vals = vals + glint
         if (textured or sunny) and brightness:  # per pixel: texture and glint are added in radiance
             vals = _kelvin(vals, scene.band)
         return vals

@@ -38,7 +38,7 @@ import torch
 
 from ._validation import as_tensor, check_finite_range
 
-__all__ = ["Sun", "SUN_RADIUS", "glint_radiance"]
+__all__ = ["Sun", "SUN_RADIUS", "glint_radiance", "sun_masking_factor"]
 
 SUN_RADIUS = math.radians(0.2666)  # angular radius of the sun's disk at 1 AU [rad]
 _SQRT_HALF = math.sqrt(0.5)
@@ -224,8 +224,23 @@ def glint_radiance(view_zenith: Any, view_azimuth: Any, slopes: Any, refractive_
     l_sun = e_sun / (4.0 * math.pi * torch.sin(0.5 * alpha) ** 2)  # Ω_sun = 2π(1 − cos α), without cancellation
     out = rho * t_g * l_sun * prob / D
     if sun_masking:
-        gs = _geometry(tz.clamp_max(math.pi / 2), tp, vx, vy, cxy, mx, my)
-        d_sun = _denominator(gs, True)
-        e_s = (gs.ct + gs.st * gs.mu).clamp_min(0.0)
-        out = out * (e_s / d_sun.clamp_min(torch.finfo(dtype).tiny)).clamp(0.0, 1.0)
+        out = out * sun_masking_factor(slopes, sun, dtype, device)
     return torch.where(above, out, torch.zeros_like(out))
+
+
+def sun_masking_factor(slopes: Any, sun: Sun, dtype: torch.dtype = torch.float64, device: Any = None) -> torch.Tensor:
+    """Smith's G1 for the sun's direction [dimensionless, in [0, 1]]: e_s / D_s, D_s the projected area
+    of the facets towards the sun (Eq. 5's denominator for the sun's direction) and e_s that of their
+    mean plane (cos θ_sun for zero-mean slopes: G1 = 1/(1 + Λ_sun)).
+
+    A textured sea applies the G1 of the scene's total slope law to every pixel's glint (the resolved
+    waves mask the sun too), so that its ensemble mean is the expectation's glint."""
+    from .expectation import _denominator, _geometry
+
+    tz, tp = as_tensor(sun.zenith, dtype, device), as_tensor(sun.azimuth, dtype, device)
+    vx, vy, cxy = slopes.tensors(dtype, device)
+    mx, my = slopes.mean_tensors(dtype, device)
+    gs = _geometry(tz.clamp_max(math.pi / 2), tp, vx, vy, cxy, mx, my)
+    d_sun = _denominator(gs, True)
+    e_s = (gs.ct + gs.st * gs.mu).clamp_min(0.0)
+    return (e_s / d_sun.clamp_min(torch.finfo(dtype).tiny)).clamp(0.0, 1.0)
