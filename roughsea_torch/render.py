@@ -741,6 +741,9 @@ def render(
                 img = _apply_path(scene.path, img, altitude, geom.range_m, sea, p["air_scale"])
         if bool((~sea).any()):
             sky_pix = _sky_rows(p["sky"], p["air_scale"], scene, geom.cos_view_zenith.reshape(B, -1), altitude).reshape(B, H, W)
+            if scene.sun is not None:
+                sky_pix = sky_pix + _sun_disk_pixels(scene, B, slice(None), geom.cos_view_zenith, geom._dx, geom._dy, ~sea,
+                                                     1.0 / cameras.fx.to(dtype))
             img = sky_pix if img is None else torch.where(sea, img, sky_pix)
         img = img.reshape(B, 1, H, W)
         if output == "brightness_temperature":
@@ -799,6 +802,22 @@ def _foam_mix(values: torch.Tensor, theta: torch.Tensor, p: dict[str, Any], idx:
     """(1 − f) · values + f · R_foam(θ̂), per element (``idx`` the image of each element)."""
     f = p["foam"][idx].to(values.dtype)
     return values + f * (_foam_radiance(theta, p, idx, scene) - values)
+
+
+def _sun_disk_pixels(scene: SeaScene, B: int, idx: slice, dz: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor,
+                     sky: torch.Tensor, ifov: torch.Tensor) -> torch.Tensor:
+    """The sun's own disk in the sky pixels of images ``idx``: L_sun = E_sun / Ω_sun (the irradiance at
+    the surface: the air between the sea and the camera is neglected) times the share of each pixel
+    the disk covers, an edge one pixel wide (δ = the camera's IFOV at its centre). (b, H, W)."""
+    dtype, device = dz.dtype, dz.device
+    sun = scene.sun
+    z, a, e, r = (per_batch(f"sun {n}", v, B, dtype, device)[idx][:, None, None] for n, v in
+                  (("zenith", sun.zenith), ("azimuth", sun.azimuth), ("irradiance", sun.irradiance), ("radius", sun.radius)))
+    cos_ang = (dx * torch.sin(z) * torch.cos(a) + dy * torch.sin(z) * torch.sin(a) + dz * torch.cos(z)).clamp(-1.0, 1.0)
+    ang = 2.0 * torch.asin((0.5 * torch.sqrt((2.0 - 2.0 * cos_ang).clamp_min(0.0))).clamp(max=1.0))  # no cancellation
+    cover = ((r - ang) / ifov[:, None, None] + 0.5).clamp(0.0, 1.0)
+    l_sun = e / (4.0 * math.pi * torch.sin(0.5 * r) ** 2)
+    return torch.where(sky & (cover > 0), l_sun * cover, torch.zeros_like(dz))
 
 
 def _relative_sun(scene: SeaScene, p: dict[str, Any], B: int, dtype: torch.dtype, device: torch.device,
@@ -1155,6 +1174,9 @@ def _render_table(
             if p["foam"] is not None:
                 glint = glint * (1.0 - p["foam"][sl].to(dtype))[:, None, None]
             vals = vals + glint
+        if sunny and has_sky:  # the sun's disk itself, where it is in view
+            ifov = (1.0 / cg.cameras.fx.to(dtype))[sl]
+            vals = vals + _sun_disk_pixels(scene, B, sl, cos, dx, dy, ~sea, ifov)
         if (textured or sunny) and brightness:  # per pixel: texture and glint are added in radiance
             vals = _kelvin(vals, scene.band)
         return vals

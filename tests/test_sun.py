@@ -233,3 +233,18 @@ def test_textured_glint_table_matches_per_pixel():
     table, direct, mean = rs.render(cams, scene([1, 2])), rs.render(cams, scene([1, 2]), method="direct"), rs.render(cams, scene(None))
     assert float(((table - direct) / direct).abs().max()) < 3e-4
     assert float((table / mean).max()) > 1.2 and float((table / mean).min()) < 0.8
+
+
+def test_the_suns_disk_in_the_sky_carries_its_irradiance():
+    """A narrow camera looking at the sun 3° above the horizon: the disk's radiance summed over the
+    sky pixels' solid angles is E_sun (1 %), and the table render equals the per-pixel one."""
+    cams = rs.make_camera(128, 160, hfov_deg=3.0, altitude_m=20.0, pitch_deg=3.0, dtype=torch.float64)
+    sun = rs.Sun(math.radians(87.0), 0.0, 12.0)
+    scene = rs.SeaScene(wind_speed=6.0, sea_temperature=290.0, band=rs.MWIR, sun=sun)
+    img = rs.render(cams, scene)
+    night = rs.render(cams, rs.SeaScene(wind_speed=6.0, sea_temperature=290.0, band=rs.MWIR))
+    sky = ~rs.view_geometry(cams).is_sea[0]
+    total = float(((img - night)[0, 0] * sky).sum()) / float(cams.fx[0]) ** 2  # pixel solid angle ≈ 1/f² here
+    assert abs(total / 12.0 - 1) < 0.01
+    direct = rs.render(cams, scene, method="direct")
+    assert float(((img - direct) / direct).abs().max()) < 1e-5
