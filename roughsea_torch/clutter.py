@@ -295,7 +295,7 @@ class TextureTable:
         outer, inner = self.quadrature
         t_s, t_rho, _ = _reflection_terms(torch.acos(ct.clamp(-1.0, 1.0))[:, None], ph[:, None], stats,
                                           (p["n"][sl][img, None], p["k"][sl][img, None]), sky_m, scene.shadowing,
-                                          q.with_(outer=outer, inner=inner), None)
+                                          q.with_(outer=outer, inner=inner), None, scene.sky_masking)
         if p["air_scale"] is not None:
             t_s = t_s * p["air_scale"][sl][img, None].to(t_s.dtype)
         rb = p["rb"][sl][img, None].to(t_s.dtype)

@@ -265,8 +265,11 @@ def _sky_numerator(
     sky: Callable[[torch.Tensor], torch.Tensor],
     q: Quadrature,
     split: bool,
+    masking: bool = False,
 ) -> tuple[torch.Tensor, torch.Tensor]:
-    """(∫_C N t ρ(Ω) R_s(θ') ds, ∫_C N t ρ(Ω) ds) over the disc C of sky-reflecting facets."""
+    """(∫_C N t ρ(Ω) R_s(θ') ds, ∫_C N t ρ(Ω) ds) over the disc C of sky-reflecting facets; with
+    ``masking`` each ρ times Smith's G1 of the reflected ray (the masked part of the ray sees the
+    sea, R_B, which the form R_B (1 − T_ρ) + T_s then takes care of)."""
     dtype, device = g.ct.dtype, g.ct.device
     tiny = torch.finfo(dtype).tiny
     xo, wo = _nodes("gl", q.outer, dtype, device)
@@ -343,6 +346,20 @@ def _sky_numerator(
     m = cos_r.shape[0]
     radiance = sky(cos_r.reshape(m, -1)).reshape(cos_r.shape)
     w_rho = Wz * 0.5 * (rs + rp)
+    if masking:
+        # the reflected ray r = 2 (n·v) n − v in the view frame (u along the view, v across), and the
+        # rms slope of the law along r's azimuth: Λ = [φ(μ) − μ (1 − Φ(μ))]/μ, μ = cot θ'/σ(r)
+        uu = u[..., None]
+        rx = 2.0 * t[..., None] * uu * inv - st[:, None, None]
+        ry = 2.0 * t[..., None] * v * inv
+        rh2 = (rx * rx + ry * ry).clamp_min(tiny)
+        su2 = (su * su)[:, None, None]
+        kap, tau2 = g.kappa[:, None, None], (g.tau * g.tau)[:, None, None]
+        s2 = (su2 * rx * rx + 2.0 * kap * su2 * rx * ry + (tau2 + kap * kap * su2) * ry * ry) / rh2
+        mu_r = cos_r / torch.sqrt(rh2 * s2.clamp_min(tiny))
+        mu_c = mu_r.clamp_min(1e-6)
+        lam = (_phi(mu_c) - mu_c * _Phi(-mu_c)) / mu_c
+        w_rho = w_rho / (1.0 + lam)
     wt = W * t
     return (wt * (w_rho * radiance).sum(-1)).sum(-1), (wt * w_rho.sum(-1)).sum(-1)
 
@@ -355,6 +372,7 @@ def _sky_terms(
     shape: torch.Size,
     D: torch.Tensor,
     q: Quadrature,
+    masking: bool = False,
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """Flat (T_s, T_ρ) = (1/D)(∫_C N t ρ R_s, ∫_C N t ρ), so that R_a = R_B (1 − T_ρ) + T_s (Eq. 10).
 
@@ -372,7 +390,8 @@ def _sky_terms(
         step = max(1, q.chunk // ((3 if split else 1) * q.outer * q.inner))
 
         def one(sel: torch.Tensor, split: bool = split) -> tuple[torch.Tensor, torch.Tensor]:
-            i_s, i_r = _sky_numerator(g.take(sel), n[sel], k[sel], _sky_chunk(sky_fn, shape, sel, device), q, split)
+            i_s, i_r = _sky_numerator(g.take(sel), n[sel], k[sel], _sky_chunk(sky_fn, shape, sel, device), q, split,
+                                      masking)
             return i_s / D[sel], i_r / D[sel]
 
         # chunks on worker threads of one intra-op thread each (roughsea_torch._parallel)
@@ -555,6 +574,7 @@ def apparent_radiance(
     sun: Any = None,
     sun_masking: bool = True,
     foam_fraction: Any = None,
+    sky_masking: bool = False,
 ) -> torch.Tensor:
     """Apparent radiance of the rough sea, Eq. 10 [W m⁻² sr⁻¹ (units of the radiances given)].
 
@@ -575,6 +595,8 @@ def apparent_radiance(
             :class:`~roughsea_torch.sun.Sun`: its reflection off the waves (the glint,
             :func:`~roughsea_torch.sun.glint_radiance`) is added; ``sky`` is then the rest of the sky.
         sun_masking: with a sun, Smith's masking of the facets from the sun's side (default True).
+        sky_masking: Smith's masking of the reflected ray (its masked part meets the sea and sees
+            R_B), off by default as in the paper; Mitsuba 3's rough dielectrics include it.
         foam_fraction: ``None`` (default, no foam) or the whitecap fraction f in [0, 1] (e.g.
             :func:`~roughsea_torch.foam.whitecap_fraction` of the wind): (1 − f) R_a + f R_foam,
             R_foam = ε_f R_B + (1 − ε_f) E_sky/π (:mod:`roughsea_torch.foam`).
@@ -592,7 +614,8 @@ def apparent_radiance(
     """
     check_finite_range("sea_radiance", sea_radiance, 0.0, unit="W m-2 sr-1")
     t_s, t_rho, dtype = _reflection_terms(
-        view_zenith, view_azimuth, slopes, refractive_index, sky, shadowing, quadrature, dict(sea_radiance=sea_radiance)
+        view_zenith, view_azimuth, slopes, refractive_index, sky, shadowing, quadrature, dict(sea_radiance=sea_radiance),
+        sky_masking,
     )
     rb = as_tensor(sea_radiance, dtype, t_s.device).to(t_s.dtype)
     out = (rb - rb * t_rho + t_s).to(dtype)
@@ -647,6 +670,7 @@ def _reflection_terms(
     shadowing: bool,
     quadrature: Quadrature | None,
     _extra: dict | None,
+    sky_masking: bool = False,
 ) -> tuple[torch.Tensor, torch.Tensor, torch.dtype]:
     """(T_s, T_ρ) in the working dtype (:func:`_work_dtype`), and the call's dtype."""
     sky_fn = as_sky(sky)
@@ -669,5 +693,5 @@ def _reflection_terms(
         return z, z, dtype
     D = _denominator(g, shadowing)
     nf, kf = n.expand(shape).reshape(-1), k.expand(shape).reshape(-1)
-    t_s, t_rho = _sky_terms(g, nf, kf, sky_fn, shape, D, q)
+    t_s, t_rho = _sky_terms(g, nf, kf, sky_fn, shape, D, q, sky_masking)
     return t_s.reshape(shape), t_rho.reshape(shape), dtype

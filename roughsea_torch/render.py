@@ -107,6 +107,8 @@ class SeaScene:
             a named ``sky`` is needed). :func:`roughsea_torch.solar.sun_position` gives them from a
             date, time and place (pvlib); note its azimuth is from north, clockwise.
         sun_masking: Smith's masking of the facets from the sun's side (default True).
+        sky_masking: Smith's masking of the reflected ray on the sky term (default False, the paper's
+            model; Mitsuba 3's rough surfaces include it): its masked part sees the sea.
         foam: the whitecap fraction of the sea surface: ``"auto"`` (default: Monahan &
             O'Muircheartaigh's (1980) law at ``wind_speed``, for thermal-infrared bands; none with
             ``slopes=`` or another band), a number or (B,) tensor in [0, 1], or ``False``. Foam is an
@@ -142,6 +144,7 @@ class SeaScene:
         sun_zenith: Any = None,
         sun_azimuth: Any = 0.0,
         sun_masking: bool = True,
+        sky_masking: bool = False,
         foam: Any = "auto",
     ):
         if (slopes is None) == (wind_speed is None):
@@ -220,6 +223,7 @@ class SeaScene:
         self._sun = sun
         self.sun_zenith, self.sun_azimuth = sun_zenith, sun_azimuth
         self.sun_masking = sun_masking
+        self.sky_masking = bool(sky_masking)
         if foam is None or foam is False:
             foam = None
         elif isinstance(foam, str):
@@ -773,7 +777,7 @@ def _sea_direct(geom: ViewGeometry, p: dict[str, Any], scene: SeaScene, q: Quadr
     vals = apparent_radiance(
         th, ph, slopes, (p["n"][img_idx], p["k"][img_idx]), sea_radiance=p["rb"][img_idx], sky=sky,
         shadowing=scene.shadowing, quadrature=q, sun=_relative_sun(scene, p, B, dtype, device, img_idx),
-        sun_masking=scene.sun_masking,
+        sun_masking=scene.sun_masking, sky_masking=scene.sky_masking,
     )
     if p["foam"] is not None:
         vals = _foam_mix(vals, th, p, img_idx, scene)
@@ -933,7 +937,8 @@ def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str
     ap = visible_slope(x[sea][:, None], torch.cos(th), torch.sin(th), torch.sqrt(va_.clamp_min(1e-30)), sig_u)[:, 0]
     slopes = unresolved_statistics(vx, vy, cxy, ph, va_, kp_, ap)
     vals = apparent_radiance(th, ph, slopes, (p["n"][img_idx], p["k"][img_idx]), sea_radiance=p["rb"][img_idx],
-                             sky=select_sky(p["sky"], img_idx.cpu()), shadowing=scene.shadowing, quadrature=q)
+                             sky=select_sky(p["sky"], img_idx.cpu()), shadowing=scene.shadowing, quadrature=q,
+                             sky_masking=scene.sky_masking)
     sun = _relative_sun(scene, p, B, dtype, device, img_idx)
     if sun is not None:  # the pixel's own glint, masked from the sun by the total law (sun_masking_factor)
         from .sun import glint_radiance, sun_masking_factor
@@ -1067,7 +1072,7 @@ def _render_table(
         slopes = SlopeStatistics.from_variances(p["vx"][sl, None, None], p["vy"][sl, None, None], p["cxy"][sl, None, None])
         sky = _sky_per_image(select_sky(p["sky"], sl), b_, dtype, device, 2)
         t_s, t_rho, _ = _reflection_terms(vz, va, slopes, (p["n"][sl, None, None], p["k"][sl, None, None]), sky,
-                                          scene.shadowing, q, None)
+                                          scene.shadowing, q, None, scene.sky_masking)
         if p["air_scale"] is not None:
             t_s = t_s * p["air_scale"][sl, None, None].to(t_s.dtype)
         rb = p["rb"][sl, None, None].to(t_s.dtype)

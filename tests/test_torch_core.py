@@ -272,3 +272,57 @@ def test_band_refractive_index_fit_reproduces_band_averaged_reflectance(band, to
     assert fit <= tol
     if band[0] == 8e-6:  # LWIR: the fit is what makes the difference
         assert avg > 20 * fit
+
+
+@pytest.mark.parametrize("th_deg", [75.0, 86.0])
+def test_sky_masking_against_an_independent_slope_integral(th_deg):
+    """apparent_radiance(sky_masking=True): Smith's G1 of the reflected ray on the sky term, the masked
+    part seeing the sea, against a plain scipy integral over slopes written here (isotropic law,
+    analytic sky); the masking's own effect is resolved to 1 %, and R_s ≡ R_B still gives R_B."""
+    from scipy import integrate
+    from scipy.special import erfc
+
+    sig2, rb, m = 0.02, 30.0, 1.3 + 0.02j
+    sky = lambda c: 10.0 + 20.0 * (1.0 - c) ** 6  # noqa: E731
+    th = math.radians(th_deg)
+    st, ct = math.sin(th), math.cos(th)
+
+    def fresnel(c):
+        root = np.sqrt(m * m - (1 - c * c) + 0j)
+        return 0.5 * (abs((c - root) / (c + root)) ** 2 + abs((m * m * c - root) / (m * m * c + root)) ** 2)
+
+    def g1(rx, ry, rz):
+        mu = rz / (math.hypot(rx, ry) * math.sqrt(sig2))
+        lam = (math.exp(-mu * mu / 2) / math.sqrt(2 * math.pi) - mu * 0.5 * erfc(mu / math.sqrt(2))) / mu
+        return 1.0 / (1.0 + lam)
+
+    def integrand(v, u, masking):
+        t = ct + st * u
+        if t <= 0:
+            return 0.0
+        nn = math.sqrt(1 + u * u + v * v)
+        n = np.array([u, v, 1.0]) / nn  # the facet normal leans towards its slope: ∝ (s, 1)
+        view = np.array([st, 0.0, ct])
+        c = float(n @ view)
+        r = 2 * c * n - view
+        if r[2] <= 0:
+            return 0.0
+        w = math.exp(-(u * u + v * v) / (2 * sig2)) / (2 * math.pi * sig2) * t * fresnel(c) * (sky(r[2]) - rb)
+        return w * (g1(*r) if masking else 1.0)
+
+    L = 7 * math.sqrt(sig2)
+    mu = ct / (st * math.sqrt(sig2))
+    D = ct * 0.5 * erfc(-mu / math.sqrt(2)) + st * math.sqrt(sig2) * math.exp(-mu * mu / 2) / math.sqrt(2 * math.pi)
+    ref = {}
+    for masking in (False, True):
+        val, _ = integrate.dblquad(lambda v, u: integrand(v, u, masking), -L, L, -L, L, epsabs=1e-10, epsrel=1e-9)
+        ref[masking] = rb + val / D
+    slopes = rs.SlopeStatistics.isotropic(2 * sig2)
+    got = {mk: float(rs.apparent_radiance(torch.tensor(th, dtype=torch.float64), 0.0, slopes, m, sea_radiance=rb, sky=sky,
+                                          sky_masking=mk)) for mk in (False, True)}
+    assert abs(got[False] / ref[False] - 1) < 1e-6
+    effect_ref, effect = ref[True] - ref[False], got[True] - got[False]
+    assert abs(effect_ref) > 1e-4 * rb
+    assert abs(effect / effect_ref - 1) < 0.01
+    same = rs.apparent_radiance(torch.tensor(th, dtype=torch.float64), 0.0, slopes, m, sea_radiance=rb, sky=rb, sky_masking=True)
+    assert abs(float(same) - rb) < 1e-12 * rb
