@@ -4,7 +4,12 @@ The seas are textured by default (``scene.texture = true``: one wave-field reali
 its seed and time [s] in the metadata); ``texture = false`` gives the expectation images.
 ``clip_length = T > 1`` makes clips of T frames at ``frame_rate`` [Hz] from a camera on a
 moving platform (ranges in the ``[motion]`` table; ``pipelines/configs/sea_lwir_clips.toml``),
-with every frame's time, pose and noise seed in the metadata.
+with every frame's time, pose and noise seed in the metadata. Day images: ``scene.daytime`` (the
+probability that an image is by day, default 0: all by night) puts the sun in the sky at an
+elevation drawn from ``scene.sun_elevation_deg`` and an azimuth from ``scene.sun_azimuth_deg``
+(relative to the camera's yaw: 0 is straight ahead, where its glint is); each image's ``is_day``,
+sun elevation, zenith and world azimuth are in the metadata (``pipelines/configs/sea_mwir_day.toml``:
+MWIR by day, the glint of a low sun ahead).
 
 One process (with DataLoader workers rendering shards in parallel):
 

@@ -63,6 +63,7 @@ __all__ = [
     "SCENE_FIELDS",
     "MOTION_FIELDS",
     "CALM_WIND_SPEED",
+    "SUN_FIELDS",
 ]
 
 # (name, allowed range, unit, default range); the order is the order of the draws
@@ -86,6 +87,11 @@ MOTION_FIELDS: tuple[tuple[str, tuple[float, float], str, Any], ...] = (
     ("pitch_period_s", (0.1, 3600.0), "s", (5.0, 12.0)),
     ("roll_period_s", (0.1, 3600.0), "s", (5.0, 12.0)),
     ("heave_period_s", (0.1, 3600.0), "s", (5.0, 12.0)),
+)
+# the sun of day images (daytime > 0), drawn after everything else: (name, allowed range, unit, default)
+SUN_FIELDS: tuple[tuple[str, tuple[float, float], str, Any], ...] = (
+    ("sun_elevation_deg", (0.0, 90.0), "deg", (2.0, 60.0)),
+    ("sun_azimuth_deg", (-3600.0, 3600.0), "deg", (-180.0, 180.0)),
 )
 TIME_RANGE_S = (0.0, 86400.0)  # allowed range of the realizations' times [s]
 DEFAULT_TIME_S = (0.0, 3600.0)
@@ -134,6 +140,13 @@ def _range(name: str, value: Any, allowed: tuple[float, float], unit: str) -> tu
     return lo, hi
 
 
+def _check_daytime(daytime: Any) -> float:
+    """``daytime`` as a float in [0, 1], or ``ValueError`` naming it."""
+    if isinstance(daytime, bool) or not isinstance(daytime, (int, float)) or not (0.0 <= float(daytime) <= 1.0):
+        raise ValueError(f"daytime: the probability that an image is by day must be a number in [0, 1]; got {daytime!r}")
+    return float(daytime)
+
+
 def _uniform(r: tuple[float, float], u: torch.Tensor) -> torch.Tensor:
     """Uniform draws in [r0, r1) from u ∈ [0, 1) (a fixed value when r0 == r1)."""
     return r[0] + (r[1] - r[0]) * u if r[1] > r[0] else torch.full(u.shape, r[0], dtype=torch.float64)
@@ -174,14 +187,29 @@ class SceneSampler:
             ``"phase_rad"`` ∈ [0, 2π) is drawn with them. The mean pose ± amplitude must stay
             within the allowed pose (pitch in [−90, 90]°, roll in [−180, 180]°, altitude − heave
             above the sea, and within the path tables with the path on).
+        daytime: probability in [0, 1] that an image (clip) is by day, with the sun in its sky
+            (its direct irradiance from the image's atmosphere's LOWTRAN7 table in the band, its
+            glint on the sea). Default 0.0: every image by night, no sun, and no new draws (the
+            draws are those of a sampler without the sun's options, bit for bit).
+        sun_elevation_deg: range of the sun's elevation above the horizon [deg], within [0, 90]
+            (default 2–60°).
+        sun_azimuth_deg: range of the sun's azimuth [deg] (default −180–180°): relative to the
+            image's camera yaw with ``sun_azimuth_relative_to_yaw`` (default True: 0 puts the sun
+            straight ahead of the camera, where its glint is), else a world azimuth (from +x
+            towards +y, the yaw's frame).
+        sun_azimuth_relative_to_yaw: see ``sun_azimuth_deg``.
 
     ``sample(B, generator)`` returns a dict of CPU float64 tensors (B,) under these names plus
     ``"atmosphere"`` (int64 index into ``atmospheres``) and ``"noise_seed"`` (int64, for the sensor
     model's random stages). Every field is drawn on every call, fixed or not, so fixing one range
     does not change the draws of the others. The draws are made in this order: the scene fields,
     the atmosphere, the noise seed, then (``texture``) the wave seed and the time, then
-    (``motion``) the oscillations and the phase: turning texture or motion on does not change the
-    draws of the scene fields.
+    (``motion``) the oscillations and the phase, then (``daytime`` > 0) whether the image is by
+    day and the sun's elevation and azimuth: turning texture, motion or daytime on does not change
+    the draws before theirs. With ``daytime`` > 0 the draw also holds ``"is_day"`` (bool),
+    ``"sun_elevation_deg"`` and ``"sun_azimuth_deg"`` (float64 [deg]; the azimuth is the sun's
+    WORLD azimuth, the relative draw plus the yaw when relative); the sun's fields are drawn for
+    every image and used only where ``is_day``.
 
     Example:
         >>> s = SceneSampler(wind_speed=(2.0, 4.0), pitch_deg=-3.0)
@@ -196,11 +224,19 @@ class SceneSampler:
 
     def __init__(self, *, atmospheres: Sequence[str] | str = ("midlatitude_summer",), path: bool = True,
                  band: Any = LWIR, texture: bool = False, time_s: Any = DEFAULT_TIME_S,
-                 motion: dict[str, Any] | None = None, **ranges: Any):
+                 motion: dict[str, Any] | None = None, daytime: float = 0.0,
+                 sun_elevation_deg: Any = SUN_FIELDS[0][3], sun_azimuth_deg: Any = SUN_FIELDS[1][3],
+                 sun_azimuth_relative_to_yaw: bool = True, **ranges: Any):
         unknown = set(ranges) - set(_FIELD_NAMES)
         if unknown:
             raise ValueError(f"unknown scene parameter(s) {sorted(unknown)}; known: "
-                             f"{list(_FIELD_NAMES) + ['atmospheres', 'texture', 'time_s', 'motion']}")
+                             f"{list(_FIELD_NAMES) + ['atmospheres', 'texture', 'time_s', 'motion', 'daytime', 'sun_elevation_deg', 'sun_azimuth_deg', 'sun_azimuth_relative_to_yaw']}")
+        self.daytime = _check_daytime(daytime)
+        self.sun_ranges = {name: _range(name, value, allowed, unit) for (name, allowed, unit, _d), value
+                           in zip(SUN_FIELDS, (sun_elevation_deg, sun_azimuth_deg))}
+        if not isinstance(sun_azimuth_relative_to_yaw, bool):
+            raise ValueError(f"sun_azimuth_relative_to_yaw must be True or False; got {sun_azimuth_relative_to_yaw!r}")
+        self.sun_azimuth_relative_to_yaw = sun_azimuth_relative_to_yaw
         if not isinstance(path, bool):
             raise ValueError(f"path must be True or False; got {path!r}")
         if not isinstance(texture, bool):
@@ -271,6 +307,9 @@ class SceneSampler:
         out["time_s"] = list(self.time_s)
         if self.motion is not None:
             out["motion"] = {k: list(v) for k, v in self.motion.items()}
+        out["daytime"] = self.daytime
+        out.update({k: list(v) for k, v in self.sun_ranges.items()})
+        out["sun_azimuth_relative_to_yaw"] = self.sun_azimuth_relative_to_yaw
         return out
 
     def sample(self, batch_size: int, generator: torch.Generator | None = None, same_on_batch: bool = False) -> dict[str, torch.Tensor]:
@@ -300,6 +339,12 @@ class SceneSampler:
             for i, name in enumerate(_MOTION_NAMES):
                 out[name] = _uniform(self.motion[name], um[i])
             out["phase_rad"] = (2.0 * math.pi) * um[-1]
+        if self.daytime > 0.0:  # last: with daytime 0 nothing is drawn, and the draws above are as before
+            us = torch.rand(3, n, generator=generator, dtype=torch.float64)
+            out["is_day"] = us[0] < self.daytime
+            out["sun_elevation_deg"] = _uniform(self.sun_ranges["sun_elevation_deg"], us[1])
+            az = _uniform(self.sun_ranges["sun_azimuth_deg"], us[2])
+            out["sun_azimuth_deg"] = az + out["yaw_deg"] if self.sun_azimuth_relative_to_yaw else az
         if same_on_batch:
             out = {k: v.expand(batch_size).clone() for k, v in out.items()}
         return out
@@ -382,19 +427,30 @@ def _render_frames(
     textured = torch.zeros(B, dtype=torch.bool)
     if "wave_seed" in params:  # a textured draw; calm images have no resolved waves: the expectation
         textured = params["wind_speed"].detach().cpu() > CALM_WIND_SPEED
-    key = atm * 2 + textured.to(atm.dtype)
+    day = torch.zeros(B, dtype=torch.bool)
+    if "is_day" in params:  # a draw with daytime > 0: the sun in the sky of the day images
+        day = params["is_day"].detach().cpu().to(torch.bool)
+    key = atm * 4 + textured.to(atm.dtype) * 2 + day.to(atm.dtype)
     for k in torch.unique(key).tolist():
-        a, tex = k // 2, bool(k % 2)
+        a, tex, sunny = k // 4, bool((k // 2) % 2), bool(k % 2)
         idx = (key == k).nonzero()[:, 0]
 
         def f(name: str, src: dict[str, torch.Tensor] = params) -> torch.Tensor:
             return src[name][idx.to(src[name].device)].to(dtype=dtype, device=device)
 
+        sun: dict[str, Any] = {}
+        if sunny:  # zenith and world azimuth [rad], computed in float64 on the CPU, then cast
+            def g(name: str) -> torch.Tensor:
+                return params[name].detach().cpu().to(torch.float64)[idx]
+
+            sun = dict(sun_zenith=((90.0 - g("sun_elevation_deg")) * (math.pi / 180.0)).to(dtype=dtype, device=device),
+                       sun_azimuth=(g("sun_azimuth_deg") * (math.pi / 180.0)).to(dtype=dtype, device=device))
         scene = SeaScene(
             wind_speed=f("wind_speed"), anisotropic=anisotropic, wind_direction=f("wind_direction_deg") * (math.pi / 180.0),
             sea_temperature=f("sea_temperature"), air_temperature=f("air_temperature"), band=band,
             sky=atmospheres[a], path=None if path else False,
             seed=[int(s) for s in params["wave_seed"][idx.to(params["wave_seed"].device)].tolist()] if tex else None,
+            **sun,
         )
         pose = {name: f(name, frames) for name in ("pitch_deg", "roll_deg", "altitude_m", "time_s")}
         for t in range(T):
@@ -433,8 +489,12 @@ def render_parameters(
 
     A draw with ``"wave_seed"`` (``SceneSampler(texture=True)``) renders each image's textured sea,
     the realization of its wave seed at its ``"time_s"`` [s] (images with ``wind_speed`` ≤
-    :data:`CALM_WIND_SPEED`: the expectation); without it, the expectation image. Motion fields,
-    if present, are not used: a still image is at the mean pose."""
+    :data:`CALM_WIND_SPEED`: the expectation); without it, the expectation image. A draw with
+    ``"is_day"`` (``SceneSampler(daytime=...)`` > 0) puts the sun in the sky of the images where it
+    is True: ``SeaScene(sun_zenith=(90° − sun_elevation_deg), sun_azimuth=sun_azimuth_deg)`` (world
+    azimuth; radians), its direct irradiance from the image's atmosphere's LOWTRAN7 table; the
+    other images are by night, as without it. Motion fields, if present, are not used: a still
+    image is at the mean pose."""
     B = int(params["wind_speed"].shape[0])
     frames = {k: params[k].detach().cpu().to(torch.float64)[:, None] for k in ("pitch_deg", "roll_deg", "altitude_m")}
     frames["time_s"] = (params["time_s"].detach().cpu().to(torch.float64) if "time_s" in params
@@ -580,6 +640,14 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
             ``False``: the expectation image (the mean over the slope statistics, Eq. 10), with
             the same parameter draws as before texture existed.
         time_s: range of the realizations' times [s] (default [0, 3600)); see :class:`SceneSampler`.
+        daytime: probability in [0, 1] that an image is by day (default 0.0: all by night, and the
+            draws as before this option). A day image has the sun in its sky at an elevation drawn
+            from ``sun_elevation_deg`` (default 2–60°) and an azimuth from ``sun_azimuth_deg``
+            (default −180–180°; relative to the camera's yaw with ``sun_azimuth_relative_to_yaw``,
+            the default, so 0 is straight ahead, where the glint is; else world): the glint of
+            its LOWTRAN7 direct irradiance (in MWIR far brighter than the sea's emission) on the
+            sea, textured seas included. ``params["is_day"]``, ``params["sun_elevation_deg"]`` and
+            ``params["sun_azimuth_deg"]`` (world) keep the draw for replay; see :class:`SceneSampler`.
         band: sensor band (``LWIR`` default, ``MWIR`` or (λ_lo, λ_hi) [m]).
         anisotropic: Cox–Munk anisotropic (default) or isotropic slopes.
         mode: ``"replace"``: the output is the rendered sea, repeated over the input's channels
@@ -644,6 +712,10 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
         atmospheres: Sequence[str] | str = ("midlatitude_summer",),
         texture: bool = True,
         time_s: Any = DEFAULT_TIME_S,
+        daytime: float = 0.0,
+        sun_elevation_deg: Any = SUN_FIELDS[0][3],
+        sun_azimuth_deg: Any = SUN_FIELDS[1][3],
+        sun_azimuth_relative_to_yaw: bool = True,
         band: Any = LWIR,
         anisotropic: bool = True,
         mode: str = "replace",
@@ -663,7 +735,8 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
             atmospheres=atmospheres, wind_speed=wind_speed, wind_direction_deg=wind_direction_deg,
             sea_temperature=sea_temperature, air_temperature=air_temperature, altitude_m=altitude_m,
             pitch_deg=pitch_deg, roll_deg=roll_deg, yaw_deg=yaw_deg, hfov_deg=hfov_deg, path=path, band=band,
-            texture=texture, time_s=time_s,
+            texture=texture, time_s=time_s, daytime=daytime, sun_elevation_deg=sun_elevation_deg,
+            sun_azimuth_deg=sun_azimuth_deg, sun_azimuth_relative_to_yaw=sun_azimuth_relative_to_yaw,
         )
         self.output = _check_output_settings(mode, target_unit, sensor, output, generator)
         self.texture = texture
@@ -756,6 +829,9 @@ class RandomSeaClip(_Seas, torch.nn.Module):
             expectation image of its pose (only the camera moves). Clips with ``wind_speed`` ≤
             :data:`CALM_WIND_SPEED` are expectation images too.
         time_s: range of the clips' start times [s] (default [0, 3600)).
+        daytime, sun_elevation_deg, sun_azimuth_deg, sun_azimuth_relative_to_yaw: day clips, as
+            :class:`RandomSeaBackground` (drawn per clip; the sun stays put over a clip, its
+            relative azimuth from the clip's mean yaw).
         wind_speed, ..., hfov_deg, atmospheres, band, anisotropic, mode, target_unit, sensor,
             output, table, quadrature, path, generator: as :class:`RandomSeaBackground`. In
             composite mode every frame holds its own target and opacity (C = 2). With a sensor,
@@ -807,6 +883,10 @@ class RandomSeaClip(_Seas, torch.nn.Module):
         atmospheres: Sequence[str] | str = ("midlatitude_summer",),
         texture: bool = True,
         time_s: Any = DEFAULT_TIME_S,
+        daytime: float = 0.0,
+        sun_elevation_deg: Any = SUN_FIELDS[0][3],
+        sun_azimuth_deg: Any = SUN_FIELDS[1][3],
+        sun_azimuth_relative_to_yaw: bool = True,
         band: Any = LWIR,
         anisotropic: bool = True,
         mode: str = "replace",
@@ -835,7 +915,8 @@ class RandomSeaClip(_Seas, torch.nn.Module):
             atmospheres=atmospheres, wind_speed=wind_speed, wind_direction_deg=wind_direction_deg,
             sea_temperature=sea_temperature, air_temperature=air_temperature, altitude_m=altitude_m,
             pitch_deg=pitch_deg, roll_deg=roll_deg, yaw_deg=yaw_deg, hfov_deg=hfov_deg, path=path, band=band,
-            texture=texture, time_s=time_s, motion=motion,
+            texture=texture, time_s=time_s, motion=motion, daytime=daytime, sun_elevation_deg=sun_elevation_deg,
+            sun_azimuth_deg=sun_azimuth_deg, sun_azimuth_relative_to_yaw=sun_azimuth_relative_to_yaw,
         )
         self.output = _check_output_settings(mode, target_unit, sensor, output, generator)
         self.frame_rate = float(frame_rate)

@@ -10,7 +10,10 @@ Layout of an output directory::
                               of T = ``clip_length`` frames; per item ``index``, every scene
                               parameter (float64), ``atmosphere`` (name), ``noise_seed`` (int64),
                               ``image_seed`` (uint64); with ``scene.texture``: ``wave_seed``
-                              (int64) and ``time_s`` [s] (float64); for clips also the motion
+                              (int64) and ``time_s`` [s] (float64); with ``scene.daytime`` > 0:
+                              ``is_day`` (bool), ``sun_elevation_deg``, ``sun_zenith_deg`` and
+                              ``sun_azimuth_deg`` (the sun's WORLD azimuth) (float64 [deg]; drawn
+                              for every item, used only where ``is_day``); for clips also the motion
                               parameters (``pitch_amplitude_deg``, ``roll_amplitude_deg``,
                               ``heave_amplitude_m`` [m], ``*_period_s`` [s], ``phase_rad``) and
                               per frame (N, T): ``frame_time_s`` [s], ``frame_pitch_deg``,
@@ -54,6 +57,7 @@ from .augmentation import (
     DEFAULT_TIME_S,
     MOTION_FIELDS,
     SCENE_FIELDS,
+    SUN_FIELDS,
     SceneSampler,
     _range,
     frame_parameters,
@@ -77,6 +81,7 @@ DEFAULT_CONFIG: dict[str, Any] = {
     "camera": {"height": 512, "width": 640},
     "scene": {"atmospheres": ["midlatitude_summer"], "band": "LWIR", "anisotropic": True, "path": True,
               "texture": True, "time_s": list(DEFAULT_TIME_S),
+              "daytime": 0.0, **{name: list(d) for name, _a, _u, d in SUN_FIELDS}, "sun_azimuth_relative_to_yaw": True,
               **{name: (list(d) if isinstance(d, tuple) else d) for name, _a, _u, d in SCENE_FIELDS}},
     "motion": {name: list(d) for name, _a, _u, d in MOTION_FIELDS},
     "sensor": {
@@ -141,6 +146,11 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
     default 1: still images), ``frame_rate`` ([Hz], > 0, default 25; used by clips), and the
     ``motion`` table (ranges of the platform's oscillations for clips, keys of
     :data:`~roughsea_torch.augmentation.MOTION_FIELDS`: amplitudes [deg], [m], periods [s]).
+    Day images: ``scene.daytime`` (probability in [0, 1] that an item is by day, default 0.0: all
+    by night, shards as before), ``scene.sun_elevation_deg`` (range [deg] within [0, 90], default
+    [2, 60]), ``scene.sun_azimuth_deg`` (range [deg], default [-180, 180]; relative to the camera's
+    yaw, 0 straight ahead, unless ``scene.sun_azimuth_relative_to_yaw = false``: world azimuth);
+    see :class:`~roughsea_torch.augmentation.SceneSampler`.
     """
     if not isinstance(config, dict):
         raise ValueError("config must be a table/dict")
@@ -171,7 +181,7 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
     cfg["scene"].update(scene)
     sc = cfg["scene"]
     _band(sc["band"])
-    for key in ("anisotropic", "path", "texture"):
+    for key in ("anisotropic", "path", "texture", "sun_azimuth_relative_to_yaw"):
         if not isinstance(sc[key], bool):
             raise ValueError(f"config: scene.{key} must be true or false; got {sc[key]!r}")
     try:
@@ -300,6 +310,11 @@ def render_shard(cfg: dict[str, Any], k: int, sensor: torch.nn.Module | None = N
     for name in ("wave_seed", "time_s"):  # texture on (absent otherwise: such shards are as before texture)
         if name in params:
             out[name] = params[name].numpy()
+    if "is_day" in params:  # daytime > 0 (absent otherwise: such shards are as before the sun)
+        out["is_day"] = params["is_day"].numpy()
+        out["sun_elevation_deg"] = params["sun_elevation_deg"].numpy()
+        out["sun_zenith_deg"] = (90.0 - params["sun_elevation_deg"]).numpy()
+        out["sun_azimuth_deg"] = params["sun_azimuth_deg"].numpy()
     if frames is not None:
         for name, *_r in MOTION_FIELDS:
             out[name] = params[name].numpy()
@@ -313,14 +328,19 @@ def frame_render_parameters(meta: dict[str, Any], frame: int | None = None) -> d
     """The :func:`~roughsea_torch.augmentation.render_parameters` input (one image) of an item's
     metadata (as :class:`SeaShardDataset` yields it, or a shard's arrays at one index), for a
     still image or, with ``frame``, frame ``frame`` of a clip: its pose and time replaced by the
-    frame's. The atmosphere stays a name (``"atmosphere_name"``): map it to an index into the
-    atmospheres you render with. The sensor noise of the frame is ``frame_noise_seed[frame]`` (a
+    frame's. A day item (``is_day`` in its metadata, ``scene.daytime`` > 0) also gives ``is_day``,
+    ``sun_elevation_deg`` and ``sun_azimuth_deg`` (world). The atmosphere stays a name
+    (``"atmosphere_name"``): map it to an index into the atmospheres you render with. The sensor noise of the frame is ``frame_noise_seed[frame]`` (a
     still: ``noise_seed``)."""
     p = {k: torch.tensor([float(meta[k])], dtype=torch.float64) for k, *_r in SCENE_FIELDS}
     if "wave_seed" in meta:
         p["wave_seed"] = torch.tensor([int(meta["wave_seed"])], dtype=torch.int64)
         p["time_s"] = torch.tensor([float(meta["time_s"])], dtype=torch.float64)
     p["noise_seed"] = torch.tensor([int(meta["noise_seed"])], dtype=torch.int64)
+    if "is_day" in meta:  # the sun of a day item (world azimuth; the renderer uses the elevation)
+        p["is_day"] = torch.tensor([bool(meta["is_day"])])
+        p["sun_elevation_deg"] = torch.tensor([float(meta["sun_elevation_deg"])], dtype=torch.float64)
+        p["sun_azimuth_deg"] = torch.tensor([float(meta["sun_azimuth_deg"])], dtype=torch.float64)
     if frame is not None:
         if "frame_time_s" not in meta:
             raise ValueError("frame: this item is a still image (no per-frame metadata); pass frame=None")
@@ -375,7 +395,8 @@ def _metadata(cfg: dict[str, Any]) -> dict[str, Any]:
             "units": {"images": "sensor counts (uint16); see sensor.counts for the radiance mapping",
                       "temperatures": "K", "angles": "deg", "altitude_m": "m", "wind_speed": "m/s at 12.5 m",
                       "time_s": "s", "frame_rate": "Hz", "heave_amplitude_m": "m", "periods": "s",
-                      "phase_rad": "rad"}}
+                      "phase_rad": "rad", "sun_elevation_deg": "deg above the horizon",
+                      "sun_zenith_deg": "deg", "sun_azimuth_deg": "deg, world azimuth (from +x towards +y, as yaw_deg)"}}
 
 
 def generate(

@@ -184,6 +184,48 @@ def test_texture_off_makes_expectation_images(tmp_path):
         assert torch.equal(c[0].round(), img)
 
 
+DAY = dict(CFG, seed=1, num_images=3, shard_size=3, batch_size=3,
+           scene=dict(CFG["scene"], atmospheres=["tropical"], band="MWIR", daytime=0.5, sun_elevation_deg=[5.0, 20.0],
+                      sun_azimuth_deg=[-20.0, 20.0]))
+
+
+def test_day_metadata_reproduces_each_image(tmp_path):
+    """scene.daytime > 0: each item's metadata holds is_day and its sun (elevation, zenith, world
+    azimuth), the sampler's at (seed, index), ahead of the camera; re-rendering a day image and a
+    night one (rendered in one batch) alone from it gives their counts bit for bit."""
+    generate(DAY, tmp_path, progress=False)
+    sensor = build_sensor(resolve_config(DAY))
+    mwir, atmospheres = (3e-6, 5e-6), ("tropical",)
+    items = list(SeaShardDataset(tmp_path))
+    s = SceneSampler(atmospheres=atmospheres, wind_speed=(2.0, 12.0), air_temperature=(285.0, 300.0), texture=True,
+                     band=mwir, daytime=0.5, sun_elevation_deg=(5.0, 20.0),
+                     sun_azimuth_deg=(-20.0, 20.0)).sample_indexed(1, range(3))
+    for _, meta in items:
+        i = meta["index"]
+        assert meta["is_day"] == bool(s["is_day"][i]) and meta["sun_azimuth_deg"] == float(s["sun_azimuth_deg"][i])
+        assert meta["sun_zenith_deg"] == 90.0 - meta["sun_elevation_deg"] and 70.0 <= meta["sun_zenith_deg"] <= 85.0
+        assert -20.0 <= meta["sun_azimuth_deg"] - meta["yaw_deg"] <= 20.0
+    day = [(img, m) for img, m in items if m["is_day"]]
+    night = [(img, m) for img, m in items if not m["is_day"]]
+    assert day and night  # both kinds in the batch (seed 1: day, day, night)
+    for img, meta in (day[0], night[0]):
+        p = frame_render_parameters(meta)
+        assert bool(p["is_day"]) == meta["is_day"]
+        p["atmosphere"] = torch.tensor([0])
+        c = sensor(render_parameters(p, 20, 28, atmospheres, band=mwir),
+                   generator=torch.Generator().manual_seed(int(meta["noise_seed"])))
+        assert torch.equal(c[0].round(), img)
+
+
+def test_mwir_day_config_resolves():
+    import tomllib
+
+    cfg = resolve_config(tomllib.loads((ROOT / "pipelines" / "configs" / "sea_mwir_day.toml").read_text()))
+    sc = cfg["scene"]
+    assert sc["band"] == "MWIR" and sc["daytime"] > 0 and sc["sun_elevation_deg"] == [3.0, 40.0]
+    assert sc["sun_azimuth_deg"] == [-60.0, 60.0] and sc["sun_azimuth_relative_to_yaw"] is True
+
+
 def test_reader_splits_over_workers_and_converts_to_radiance(reference):
     ds = SeaShardDataset(reference, radiance=True)
     assert len(ds) == 7
@@ -226,6 +268,10 @@ def test_reader_splits_over_workers_and_converts_to_radiance(reference):
         ({"sensor": {"lens": {}}}, "sensor.lens"),
         ({"scene": {"texture": "yes"}}, "scene.texture"),
         ({"scene": {"time_s": [-5.0, 10.0]}}, "scene.time_s"),
+        ({"scene": {"daytime": 1.5}}, "scene.daytime"),
+        ({"scene": {"sun_elevation_deg": [10.0, 95.0]}}, "scene.sun_elevation_deg"),
+        ({"scene": {"sun_azimuth_deg": [30.0, -30.0]}}, "scene.sun_azimuth_deg"),
+        ({"scene": {"sun_azimuth_relative_to_yaw": 1}}, "scene.sun_azimuth_relative_to_yaw"),
         ({"clip_length": 0}, "clip_length"),
         ({"frame_rate": 0.0}, "frame_rate"),
         ({"motion": {"pitch_amp": 1.0}}, "motion.pitch_amp"),
