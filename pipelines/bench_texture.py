@@ -1,4 +1,5 @@
-"""Speed and memory of textured seas (``SeaScene(seed=...)``) against the expectation images, in one run.
+"""Speed and memory of textured seas (``SeaScene(seed=...)``) against the expectation images, and of
+daytime scenes (the sun's glint) against the same by night, in one run.
 
 The README's default scene (LOWTRAN7 midlatitude-summer sky, path on, radiance), 16 images 512×640,
 float32, each with its own wind, direction, sea temperature and camera pose (altitude 10–500 m,
@@ -17,6 +18,7 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import json
+import math
 import os
 import platform
 import subprocess
@@ -101,6 +103,21 @@ def main() -> None:
         t_tex = med(lambda: rs.render(cams, tex_scene), args.repeats)
         rows.append((threads, t_mean, t_tex))
         lines.append(f"| {threads} | {t_mean:.3f} | {t_tex:.3f} | {t_tex / t_mean:.2f} |")
+        print(lines[-1], file=sys.stderr)
+    # by day: the same batch with the sun 10° above the horizon straight ahead of each camera (its
+    # glint per pixel where it can be seen), LOWTRAN7 irradiance, against the same batch by night
+    cam, sc = batch(B)
+    ahead = torch.deg2rad(cam["yaw_deg"].double())
+    day_kw = dict(sun_zenith=torch.full((B,), math.radians(80.0), dtype=torch.float64), sun_azimuth=ahead)
+    lines += ["", "By day: the sun 10° above the horizon ahead of each camera (LOWTRAN7 irradiance), 1 thread:", "",
+              "| render | night [s] | day [s] | day / night |", "|---|---:|---:|---:|"]
+    torch.set_num_threads(1)
+    for name, extra in (("expectation", {}), ("textured", dict(seed=list(range(B)), time_s=12.5))):
+        night = rs.SeaScene(**sc, **extra)
+        day = rs.SeaScene(**sc, **extra, **day_kw)
+        t_n = med(lambda: rs.render(cams, night), args.repeats)
+        t_d = med(lambda: rs.render(cams, day), args.repeats)
+        lines.append(f"| {name} | {t_n:.3f} | {t_d:.3f} | {t_d / t_n:.2f} |")
         print(lines[-1], file=sys.stderr)
     lines += ["", "Peak resident memory over the process's before the render (separate processes):", "",
               "| render | peak [MB] | output [MB] | peak / output |", "|---|---:|---:|---:|"]

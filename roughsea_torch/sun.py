@@ -42,6 +42,7 @@ __all__ = ["Sun", "SUN_RADIUS", "glint_radiance", "sun_masking_factor"]
 
 SUN_RADIUS = math.radians(0.2666)  # angular radius of the sun's disk at 1 AU [rad]
 _SQRT_HALF = math.sqrt(0.5)
+_SMALL_ELLIPSE = 0.01  # tr K⁻¹ below which the glint's ellipse takes the second-order closed form
 _N_RAYS = 48  # rays from the mean over the ellipse (Gauss–Legendre, or uniform when the mean is inside)
 
 
@@ -83,7 +84,40 @@ def _nodes(n: int, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tens
 
 
 def _ellipse_probability(cx: torch.Tensor, cy: torch.Tensor, k11: torch.Tensor, k12: torch.Tensor,
-                         k22: torch.Tensor, det_k: torch.Tensor) -> torch.Tensor:
+                         k22: torch.Tensor, det_k: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """P(z ∈ E') and its first moment ∫_E' z φ₂: the closed form of a small ellipse where E' is much
+    smaller than the unit Gaussian (most glint pixels, slopes broader than the sun), the ray
+    integration (:func:`_ellipse_probability_rays`) elsewhere (calm seas)."""
+    tr_s = (k11 + k22) / det_k  # trace of S = K⁻¹: the ellipse's squared semi-axes summed
+    small = tr_s < _SMALL_ELLIPSE
+    if bool(small.all()):
+        return _small_ellipse(cx, cy, k11, k12, k22, det_k)
+    if not bool(small.any()):
+        return _ellipse_probability_rays(cx, cy, k11, k12, k22, det_k)
+    out = [torch.empty_like(cx) for _ in range(3)]
+    for sel, fn in ((small, _small_ellipse), (~small, _ellipse_probability_rays)):
+        vals = fn(cx[sel], cy[sel], k11[sel], k12[sel], k22[sel], det_k[sel])
+        out = [o.index_put((sel,), v) for o, v in zip(out, vals)]
+    return out[0], out[1], out[2]
+
+
+def _small_ellipse(cx: torch.Tensor, cy: torch.Tensor, k11: torch.Tensor, k12: torch.Tensor, k22: torch.Tensor,
+                   det_k: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """A small ellipse E' = {c + w : wᵀ K w ≤ 1}: expanding φ₂(c + w) to second order in w over it,
+    P = area φ₂(c) [1 + (cᵀ S c − tr S)/8] and ∫ z φ₂ = area φ₂(c) [c (1 + (cᵀ S c − tr S)/8) − S c/4]
+    (S = K⁻¹, area = π √det S); the next terms are O(|S|² |c|⁴)/192, below 1e-6 where tr S < 0.01
+    and |c| < 9."""
+    s11, s12, s22 = k22 / det_k, -k12 / det_k, k11 / det_k
+    area = math.pi * torch.rsqrt(det_k)
+    phi = torch.exp(-0.5 * (cx * cx + cy * cy)) / (2.0 * math.pi)
+    csc = cx * (s11 * cx + s12 * cy) + cy * (s12 * cx + s22 * cy)
+    f = 1.0 + (csc - (s11 + s22)) / 8.0
+    base = area * phi
+    return (base * f).clamp(0.0, 1.0), base * (cx * f - (s11 * cx + s12 * cy) / 4.0), base * (cy * f - (s12 * cx + s22 * cy) / 4.0)
+
+
+def _ellipse_probability_rays(cx: torch.Tensor, cy: torch.Tensor, k11: torch.Tensor, k12: torch.Tensor,
+                              k22: torch.Tensor, det_k: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """P(z ∈ E') for z ~ N(0, I₂), E' = {z : (z − c)ᵀ K (z − c) ≤ 1} (K symmetric positive definite,
     det_k its determinant, given from its factors so that it carries no cancellation).
 
