@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import json
 import math
-from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -81,17 +80,9 @@ def _path(data_dir: str | Path | None) -> Path:
     return (DATA_DIR if data_dir is None else Path(data_dir)) / TABLE
 
 
-@lru_cache(maxsize=4)
-def _read(path: str) -> dict[str, Any]:
-    with np.load(path, allow_pickle=False) as z:
-        out = {k: z[k] for k in z.files}
-    for v in out.values():
-        v.flags.writeable = False
-    out["provenance"] = json.loads(str(out["provenance"]))
-    return out
-
-
 def _tables(data_dir: str | Path | None = None) -> dict[str, Any]:
+    from .atmosphere import _read  # one reader (read-only arrays, provenance parsed, cached) for every LOWTRAN table
+
     p = _path(data_dir)
     if not p.is_file():
         raise FileNotFoundError(f"no solar table at {p} (made by pipelines/lowtran_solar.py)")
