@@ -50,7 +50,8 @@ import torch
 
 from .slopes import SlopeStatistics
 
-__all__ = ["visible_slope", "unresolved_statistics", "pixel_resolved_slope", "along_view", "footprint", "reconcile_scale"]
+__all__ = ["visible_slope", "unresolved_statistics", "two_scale_statistics", "pixel_resolved_slope", "along_view", "footprint",
+           "reconcile_scale"]
 
 _SQRT_HALF = math.sqrt(0.5)
 _INV_SQRT_2PI = 1.0 / math.sqrt(2.0 * math.pi)
@@ -89,6 +90,15 @@ def visible_slope(
         linear inverse; error ~1e-5 σ_a), differentiable in every argument. σ_a = 0 gives 0.
     """
     out_dtype, device = x.dtype, x.device
+    shape = torch.broadcast_shapes(x.shape[:-1], cos_t.shape, sin_t.shape, sigma_r.shape, sigma_u.shape)
+    rows = math.prod(shape)
+    step = max(1, 2**22 // (nodes * x.shape[-1]))  # the grid is (rows, nodes): bound it in memory
+    if rows > step:
+        xs = x.expand(*shape, x.shape[-1]).reshape(rows, x.shape[-1])
+        others = [t.expand(shape).reshape(rows) for t in (cos_t, sin_t, sigma_r, sigma_u)]
+        parts = [visible_slope(xs[i:i + step], *(o[i:i + step] for o in others), nodes=nodes, width=width)
+                 for i in range(0, rows, step)]
+        return torch.cat(parts).reshape(*shape, x.shape[-1])
     # in float64 whatever the dtype: the quantiles at the ends of the node range (x = ±4.5,
     # 1 − Φ = 3.4e-6) sit where float32's cumulative sum has lost the digits that place them, and a
     # misplaced end node of the texture's x-interpolant spreads over every x
@@ -130,6 +140,23 @@ def unresolved_statistics(
     wx, wy = c - kappa * s, s + kappa * c
     stats = SlopeStatistics.from_variances(vx - var_a * wx * wx, vy - var_a * wy * wy, cxy - var_a * wx * wy)
     return stats.shifted(a_visible * wx, a_visible * wy)
+
+
+def two_scale_statistics(
+    vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor, phi: torch.Tensor, cos_t: torch.Tensor,
+    x: torch.Tensor, var_a: torch.Tensor, kappa: torch.Tensor,
+) -> SlopeStatistics:
+    """The unresolved statistics of pixels (or table nodes) whose resolved along-view slope sits at
+    the flat-point quantile ``x`` (shape (..., n) against the others' (...)): the along-view
+    unresolved rms σ_u = √(êᵀΣê − σ_a²), the visible slope a' (:func:`visible_slope`) and
+    :func:`unresolved_statistics`. The one place the renderer builds them (table nodes, per-pixel
+    evaluation, glint)."""
+    c, s = torch.cos(phi), torch.sin(phi)
+    sig_u = torch.sqrt((vx * c * c + 2.0 * cxy * c * s + vy * s * s - var_a).clamp_min(1e-30))
+    sin_t = torch.sqrt((1.0 - cos_t * cos_t).clamp_min(0.0))
+    ap = visible_slope(x, cos_t, sin_t, torch.sqrt(var_a.clamp_min(1e-30)), sig_u)
+    e = (...,) + (None,) * (ap.ndim - phi.ndim)
+    return unresolved_statistics(vx[e], vy[e], cxy[e], phi[e], var_a[e], kappa[e], ap)
 
 
 def along_view(cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], ex: torch.Tensor, ey: torch.Tensor
@@ -263,7 +290,7 @@ class TextureTable:
         zeta = lo[:, None] + span_z[:, None] * (self.xz + 1) / 2
         th_nodes = torch.acos((eps[:, None] * torch.sinh(zeta)).clamp(0.0, 1.0)).to(dtype)
         h = altitude[sl].to(dtype)
-        cos_n, sin_n = torch.cos(th_nodes), torch.sin(th_nodes)
+        cos_n = torch.cos(th_nodes)
         L = footprint(_slant_range(cos_n, h[:, None], earth_radius_m), cos_n, self.ifov[sl, None])
         cov, _ = self.resolved(wf, L, p, sl)
         cov = tuple(c[:, :, None] for c in cov)  # (b, nz, 1)
@@ -278,19 +305,20 @@ class TextureTable:
         idx = active.nonzero(as_tuple=True)
         img = idx[0]
         full = lambda t: t.expand(b_, nz, nphi)[idx]  # noqa: E731
-        va_, kp_, su_ = full(var_a), full(kap), full(suu)
-        ct, st = full(cos_n[:, :, None]), full(sin_n[:, :, None])
+        va_, kp_ = full(var_a), full(kap)
+        ct = full(cos_n[:, :, None])
         ph = full(ph_nodes[:, None, :])
-        sig_r = torch.sqrt(va_.clamp_min(1e-30))
-        sig_u = torch.sqrt((su_ - va_).clamp_min(1e-30))
-        ap = visible_slope(self.xnodes.expand(img.numel(), -1), ct, st, sig_r, sig_u)  # (M, nx)
+        shifted = two_scale_statistics(vx[img, 0, 0], vy[img, 0, 0], cxy[img, 0, 0], ph, ct, self.xnodes.expand(img.numel(), -1),
+                                       va_, kp_)  # (M, nx)
         # one more column, the expectation itself (nothing resolved), on the same quadrature: Δ is
         # the difference of two evaluations whose quadrature errors nearly cancel, so the texture
         # nodes can take a coarser rule than the mean table (TableSize.texture_quadrature)
-        zero = torch.zeros_like(ap[:, :1])
-        ap = torch.cat([ap, zero], 1)
-        va_col = torch.cat([va_[:, None].expand_as(ap[:, :-1]), zero], 1)
-        stats = unresolved_statistics(vx[img, 0], vy[img, 0], cxy[img, 0], ph[:, None], va_col, kp_[:, None], ap)
+        cols = shifted.mean_upwind.shape
+        stats = SlopeStatistics.from_variances(
+            *(torch.cat([a.expand(cols), b[:, None]], 1) for a, b in ((shifted.var_upwind, vx[img, 0, 0]),
+                                                                    (shifted.var_crosswind, vy[img, 0, 0]),
+                                                                    (shifted.cov, cxy[img, 0, 0])))
+        ).shifted(*(torch.cat([m, torch.zeros_like(m[:, :1])], 1) for m in (shifted.mean_upwind, shifted.mean_crosswind)))
         sky_m = _sky_per_image(select_sky(sky_of_chunk(sky, b_), img.cpu()), img.numel(), dtype, device, 1)
         outer, inner = self.quadrature
         t_s, t_rho, _ = _reflection_terms(torch.acos(ct.clamp(-1.0, 1.0))[:, None], ph[:, None], stats,

@@ -814,14 +814,25 @@ def _sun_disk_pixels(scene: SeaScene, B: int, idx: slice, dz: torch.Tensor, dx: 
     the surface: the air between the sea and the camera is neglected) times the share of each pixel
     the disk covers, an edge one pixel wide (δ = the camera's IFOV at its centre). (b, H, W)."""
     dtype, device = dz.dtype, dz.device
-    sun = scene.sun
-    z, a, e, r = (per_batch(f"sun {n}", v, B, dtype, device)[idx][:, None, None] for n, v in
-                  (("zenith", sun.zenith), ("azimuth", sun.azimuth), ("irradiance", sun.irradiance), ("radius", sun.radius)))
+    z, a, e, r = (v[idx][:, None, None] for v in _sun_fields(scene, B, dtype, device))
     cos_ang = (dx * torch.sin(z) * torch.cos(a) + dy * torch.sin(z) * torch.sin(a) + dz * torch.cos(z)).clamp(-1.0, 1.0)
     ang = 2.0 * torch.asin((0.5 * torch.sqrt((2.0 - 2.0 * cos_ang).clamp_min(0.0))).clamp(max=1.0))  # no cancellation
     cover = ((r - ang) / ifov[:, None, None] + 0.5).clamp(0.0, 1.0)
     l_sun = e / (4.0 * math.pi * torch.sin(0.5 * r) ** 2)
     return torch.where(sky & (cover > 0), l_sun * cover, torch.zeros_like(dz))
+
+
+def _squeeze_last(stats: SlopeStatistics) -> SlopeStatistics:
+    """Shifted statistics of shape (..., 1) (one flat-point quantile each) as shape (...)."""
+    return SlopeStatistics.from_variances(stats.var_upwind[..., 0], stats.var_crosswind[..., 0], stats.cov[..., 0]).shifted(
+        stats.mean_upwind[..., 0], stats.mean_crosswind[..., 0])
+
+
+def _sun_fields(scene: SeaScene, B: int, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, ...]:
+    """The scene's sun as (B,) tensors: zenith, world azimuth, irradiance, radius."""
+    sun = scene.sun
+    return tuple(per_batch(f"sun {n}", v, B, dtype, device) for n, v in
+                 (("zenith", sun.zenith), ("azimuth", sun.azimuth), ("irradiance", sun.irradiance), ("radius", sun.radius)))
 
 
 def _relative_sun(scene: SeaScene, p: dict[str, Any], B: int, dtype: torch.dtype, device: torch.device,
@@ -831,9 +842,7 @@ def _relative_sun(scene: SeaScene, p: dict[str, Any], B: int, dtype: torch.dtype
         return None
     from .sun import Sun
 
-    sun = scene.sun
-    z, a, e, r = (per_batch(f"sun {n}", v, B, dtype, device) for n, v in
-                  (("zenith", sun.zenith), ("azimuth", sun.azimuth), ("irradiance", sun.irradiance), ("radius", sun.radius)))
+    z, a, e, r = _sun_fields(scene, B, dtype, device)
     return Sun(z[idx], a[idx] - p["wind_direction"][idx], e[idx], r[idx])
 
 
@@ -886,20 +895,12 @@ def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Te
         # the sun is masked by all the waves: the G1 of the total law (see sun_masking_factor)
         g1 = sun_masking_factor(slopes, s_k, dtype, device) if masking else None
         masking = False
-        from .clutter import along_view, unresolved_statistics, visible_slope
+        from .clutter import along_view, two_scale_statistics
 
-        x_k = resolved[0][keep]
         inv = torch.rsqrt((dx[keep] ** 2 + dy[keep] ** 2).clamp_min(1e-30))
         var_a, kap = along_view(tuple(c[keep] for c in resolved[1]), -dx[keep] * inv, -dy[keep] * inv)
-        vx_, vy_, cxy_ = slopes.var_upwind, slopes.var_crosswind, slopes.cov
-        cph, sph = torch.cos(phi), torch.sin(phi)
-        sig_u = torch.sqrt((vx_ * cph * cph + 2 * cxy_ * cph * sph + vy_ * sph * sph - var_a).clamp_min(1e-30))
-        # in chunks: the map's cumulative distribution is a grid of 1025 nodes per pixel
-        st_k, sr_k = torch.sqrt((1 - c_k * c_k).clamp_min(0.0)), torch.sqrt(var_a.clamp_min(1e-30))
-        step = 4096
-        ap = torch.cat([visible_slope(x_k[i:i + step, None], c_k[i:i + step], st_k[i:i + step], sr_k[i:i + step],
-                                      sig_u[i:i + step])[:, 0] for i in range(0, x_k.numel(), step)])
-        slopes = unresolved_statistics(vx_, vy_, cxy_, phi, var_a, kap, ap)
+        slopes = _squeeze_last(two_scale_statistics(slopes.var_upwind, slopes.var_crosswind, slopes.cov, phi, c_k,
+                                                    resolved[0][keep][:, None], var_a, kap))
     g = glint_radiance(torch.acos(c_k.clamp(-1.0, 1.0)), phi, slopes, (p["n"][sl][img], p["k"][sl][img]), s_k,
                        scene.shadowing, masking)
     if resolved is not None and g1 is not None:
@@ -915,7 +916,7 @@ def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str
                          q: Quadrature, B: int, dtype: torch.dtype, device: torch.device) -> torch.Tensor:
     """The textured sea per pixel (the baseline of the texture volume): each sea pixel's own
     footprint, resolved slope, visible slope a' and shifted expectation (:mod:`roughsea_torch.clutter`)."""
-    from .clutter import footprint, pixel_resolved_slope, reconcile_scale, unresolved_statistics, visible_slope
+    from .clutter import footprint, pixel_resolved_slope, reconcile_scale, two_scale_statistics
 
     sea = geom.is_sea
     wf = scene.wave_field(B, dtype, device)
@@ -934,11 +935,7 @@ def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str
     img_idx = torch.arange(B, device=device)[:, None, None].expand_as(sea)[sea]
     th, ph = geom.view_zenith[sea], _relative_azimuth(geom, p)[sea]
     vx, vy, cxy = p["vx"][img_idx], p["vy"][img_idx], p["cxy"][img_idx]
-    c, s_ = torch.cos(ph), torch.sin(ph)
-    va_, kp_ = var_a[sea], kap[sea]
-    sig_u = torch.sqrt((vx * c * c + 2 * cxy * c * s_ + vy * s_ * s_ - va_).clamp_min(1e-30))
-    ap = visible_slope(x[sea][:, None], torch.cos(th), torch.sin(th), torch.sqrt(va_.clamp_min(1e-30)), sig_u)[:, 0]
-    slopes = unresolved_statistics(vx, vy, cxy, ph, va_, kp_, ap)
+    slopes = _squeeze_last(two_scale_statistics(vx, vy, cxy, ph, torch.cos(th), x[sea][:, None], var_a[sea], kap[sea]))
     vals = apparent_radiance(th, ph, slopes, (p["n"][img_idx], p["k"][img_idx]), sea_radiance=p["rb"][img_idx],
                              sky=select_sky(p["sky"], img_idx.cpu()), shadowing=scene.shadowing, quadrature=q,
                              sky_masking=scene.sky_masking)

@@ -53,16 +53,10 @@ __all__ = [
     "sun_position",
 ]
 
-DATA_DIR = Path(__file__).resolve().parent / "data" / "lowtran"
+from .atmosphere import ATMOSPHERES as SOLAR_ATMOSPHERES  # the six LOWTRAN models, as for the sky
+from .atmosphere import _dir
+
 TABLE = "solar_direct.npz"
-SOLAR_ATMOSPHERES = (
-    "tropical",
-    "midlatitude_summer",
-    "midlatitude_winter",
-    "subarctic_summer",
-    "subarctic_winter",
-    "us_standard",
-)
 _LOG_FLOOR = 1e-30  # band values below this fraction of the band's TOA value are held at it
 
 
@@ -77,7 +71,7 @@ def air_mass(zenith_deg: Any) -> Any:
 
 
 def _path(data_dir: str | Path | None) -> Path:
-    return (DATA_DIR if data_dir is None else Path(data_dir)) / TABLE
+    return _dir(data_dir) / TABLE
 
 
 def _tables(data_dir: str | Path | None = None) -> dict[str, Any]:
