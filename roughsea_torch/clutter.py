@@ -343,9 +343,15 @@ class TextureTable:
     def pixels(self, sl: slice, p: dict, wf: Any, vol: torch.Tensor, cos_t: torch.Tensor,
                zeta: torch.Tensor, o: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, sea: torch.Tensor,
                lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, altitude: torch.Tensor,
-               earth_radius_m: float, eps: torch.Tensor) -> torch.Tensor:
+               earth_radius_m: float, eps: torch.Tensor, crest: bool = False) -> tuple:
         """The texture of every pixel of images ``sl`` (0 off the sea), (b, H, W); and each pixel's
-        flat-point quantile x and resolved covariance (world frame), for the glint."""
+        flat-point quantile x and resolved covariance (world frame), for the glint.
+
+        With ``crest=True`` a fourth element (X_r, σ_r², σ_X²) for the foam on crests
+        (:func:`~roughsea_torch.foam.crest_foam_fraction`): the pixel's resolved crest variable
+        X_r (b, H, W), sampled in the same pass over the bands as the slopes (one more channel), its
+        variance σ_r² (b, H, W) at the pixel's footprint (tabulated on the texture's rows like the
+        covariance) and the field's total σ_X² (b, 1, 1); X_r = σ_r² = 0 off the sea (f_pix = W there)."""
         import torch.nn.functional as F
 
         from .render import _slant_range
@@ -357,7 +363,7 @@ class TextureTable:
         cen = self.centres[sl]
         X = cen[:, 0, None, None] + R * dx
         Y = cen[:, 1, None, None] + R * dy
-        smp = wf.sample(X, Y, self.time[sl], footprint=L, elevation=False)
+        smp = wf.sample(X, Y, self.time[sl], footprint=L, elevation=False, crest=crest)
         gy = (2.0 * (zeta - lo.to(dtype)[:, None, None]) / span_z.to(dtype)[:, None, None] - 1.0) / (1.0 + self.ez)
         # σ_a of each pixel from the resolved covariance of its row: for one camera the footprint is a
         # function of θ̂ alone, so the covariance is tabulated on the texture's rows and read
@@ -367,7 +373,8 @@ class TextureTable:
                 dtype=torch.float64, device=lo.device) + 1) / 2)
         cos_r = (eps[:, None] * torch.sinh(rows)).clamp(1e-9, 1.0).to(dtype)
         L_r = footprint(_slant_range(cos_r, h[:, :, 0], earth_radius_m), cos_r, self.ifov[sl, None])
-        cov_rows = torch.stack(wf.resolved_covariance(L_r), 1)[..., None]  # (b, 3, rows, 1)
+        row_stats = list(wf.resolved_covariance(L_r)) + ([wf.crest_variance(L_r)] if crest else [])
+        cov_rows = torch.stack(row_stats, 1)[..., None]  # (b, 3 (+1 with crest), rows, 1)
         grid = torch.stack([torch.zeros_like(gy), gy], -1)
         cov = F.grid_sample(cov_rows, grid, mode="bilinear", padding_mode="border", align_corners=True)
         x, _, _ = pixel_resolved_slope(smp["slope_x"], smp["slope_y"], (cov[:, 0], cov[:, 1], cov[:, 2]), dx, dy)
@@ -377,7 +384,12 @@ class TextureTable:
         grid = torch.stack([gx, gy, gz], -1)[:, None]  # (b, 1, H, W, 3): x → W (azimuth), y → H (ζ), z → D (x)
         out = F.grid_sample(vol[:, None], grid, mode="bilinear", padding_mode="border", align_corners=True)[:, 0, 0]
         # x and the resolved covariance go back too: the glint of the same realization needs them
-        return torch.where(sea, out, torch.zeros_like(out)), x, (cov[:, 0], cov[:, 1], cov[:, 2])
+        result = (torch.where(sea, out, torch.zeros_like(out)), x, (cov[:, 0], cov[:, 1], cov[:, 2]))
+        if crest:
+            zero = torch.zeros_like(out)
+            result = result + ((torch.where(sea, smp["crest"], zero), torch.where(sea, cov[:, 3], zero),
+                                wf.crest_variance()[:, None, None]),)
+        return result
 
 
 def sky_of_chunk(sky: Any, b: int) -> Any:

@@ -56,10 +56,14 @@ Foam emissivity (:func:`foam_emissivity`), thermal infrared, a measurement:
     for bands centred in 2.5–6 µm); pass ``refractive_index`` (e.g. from
     :func:`~roughsea_torch.optics.band_refractive_index`) to use the one given to Eq. 10.
 
+In a textured image (``docs/waves.md`` §6) foam sits on the breaking crests:
+:func:`crest_foam_fraction` gives each pixel its own fraction f_pix from the resolved crest
+variable of the :class:`~roughsea_torch.waves.WaveField`, with E[f_pix] = W exactly and
+f_pix = W where the footprint resolves no wave; the pixel is then (1 − f_pix) R_a + f_pix R_foam.
+
 Left out: foam is a patch of the mean plane (its slopes are not those of the waves): no
 shadowing of foam, no foam on the sky-reflection weights of Eq. 10, no multiple reflection
-between foam and water, no foam temperature different from the sea's, no spray. In a textured
-image foam belongs on breaking crests; here it is an area fraction.
+between foam and water, no foam temperature different from the sea's, no spray.
 """
 
 from __future__ import annotations
@@ -84,6 +88,8 @@ __all__ = [
     "foam_radiance",
     "sky_hemispherical_mean",
     "with_foam",
+    "CREST_FOAM_FLOOR",
+    "crest_foam_fraction",
 ]
 
 MONAHAN_COEFFICIENT = 3.84e-6  # Monahan & O'Muircheartaigh 1980, W = a U10^b (fraction, U10 in m/s)
@@ -92,6 +98,10 @@ MONAHAN_EXPONENT = 3.41
 # Foam minus foam-free emissivity Δ(θ̂) [(deg, Δ)], 8–14 µm, Niclòs et al. 2007 (the last point is
 # the extrapolation of their 45°–65° slope to 90°, see the module docstring).
 FOAM_EMISSIVITY_EXCESS = ((0.0, 0.0), (45.0, 0.0), (65.0, 0.04), (90.0, 0.09))
+
+CREST_FOAM_FLOOR = 0.05  # ρ: σ_u is at least ρ σ_X (crest_foam_fraction)
+_SQRT_HALF = math.sqrt(0.5)
+_W_MIN = 1e-30  # below this whitecap fraction f_pix is scaled linearly to 0 (crest_foam_fraction)
 
 _LWIR_INDEX = 1.218 + 0.0508j  # Hale & Querry 1973, 10 µm
 _MWIR_INDEX = 1.351 + 0.0046j  # Hale & Querry 1973, 4 µm
@@ -283,3 +293,102 @@ def with_foam(apparent_radiance: Any, foam_fraction: Any, foam_radiance: Any) ->
     rf = as_tensor(foam_radiance, dtype, device)
     # Written as the two weights: exactly R_a at f = 0 and exactly R_foam at f = 1.
     return (1.0 - f) * ra + f * rf
+
+
+def crest_foam_fraction(
+    crest: Any,
+    resolved_variance: Any,
+    total_variance: Any,
+    whitecap_fraction: Any,
+    *,
+    floor: float = CREST_FOAM_FLOOR,
+) -> torch.Tensor:
+    """Foam fraction of a textured pixel, foam on the resolved crests: f_pix = Φ((X_r − c)/σ_u).
+
+    The pixel's footprint splits a Gaussian crest variable X (total variance σ_X²) into the part the
+    pixel resolves, X_r (the pixel's sample, variance σ_r²), and the unresolved rest, independent of
+    X_r, of variance σ_X² − σ_r². Foam covers the surface where X exceeds a threshold c, so the
+    fraction of the pixel's footprint under foam, given what the pixel resolves, is the probability
+    that the unresolved part lifts X above c:
+
+        f_pix = Φ((X_r − c) / σ_u),   σ_u² = max(σ_X² − σ_r², 0) + ρ² σ_X²,
+        c = Φ⁻¹(1 − W) √(σ_r² + σ_u²),
+
+    Φ the standard normal distribution function, W the whitecap fraction (Monahan &
+    O'Muircheartaigh 1980, :func:`whitecap_fraction`), ρ = ``floor``.
+
+    Exact mean. For X_r ~ N(0, σ_r²) and Z ~ N(0, 1) independent,
+    E[Φ((X_r − c)/σ_u)] = P(X_r + σ_u Z > c) = P(N(0, σ_r² + σ_u²) > c) = Φ(−Φ⁻¹(1 − W)) = W,
+    whatever σ_u: the floor ρ and the position-averaged variances only shape the pattern, never
+    the ensemble mean (c is taken with the same σ_r² + σ_u²). Far field: σ_r = 0, X_r = 0 give
+    f_pix = Φ(−Φ⁻¹(1 − W)) = W, the uniform-fraction image. Only a σ_r² that is not the true variance
+    of X_r at the point moves the mean: with :meth:`WaveField.crest_variance` (a position average)
+    the bilinear interpolation of the band tiles leaves a texel-scale ripple of the point variance
+    (``waves.WaveField``, *Evaluation*) that averages out over positions.
+
+    No bias of the slope texture. Each Fourier component's X is in phase with its elevation and its
+    slope in quadrature, so X_r and the resolved slope at a point are uncorrelated, hence (Gaussian)
+    independent: the foam mixture leaves the ensemble mean of the slope-driven texture unchanged,
+    E[(1 − f_pix) T] = (1 − W) E[T].
+
+    Which crest. X is the :class:`~roughsea_torch.waves.WaveField`'s crest variable
+    (``sample(..., crest=True)``, :meth:`~roughsea_torch.waves.WaveField.crest_variance`): the
+    downward vertical acceleration −a_z/g of the waves from the spectral peak to about ten times
+    its wavenumber (see there for the sources and the reasons). The construction itself holds for
+    any zero-mean Gaussian field: the elevation η (``sample(..., elevation=True)``,
+    :meth:`~roughsea_torch.waves.WaveField.elevation_variance`) puts the foam on the tops of the
+    highest (dominant) crests instead.
+
+    Degenerate ends. W = 0 gives exactly 0 (below W = 1e-30, f_pix is the value at 1e-30 scaled
+    by W/1e-30, which keeps the mean exact and the gradient finite); W = 1 gives exactly 1 (W is
+    ≤ 0.3 where Monahan's law holds); σ_X² = 0 (a field without crest variance) gives f_pix = W;
+    σ_u → 0 (a footprint that resolves every band) would make f_pix a step in X_r: the floor ρ keeps
+    σ_u ≥ ρ σ_X (default 0.05, an edge 0.1 σ_X wide), so f_pix and its gradients stay finite.
+
+    Args:
+        crest: X_r, the pixel's resolved crest variable (or elevation [m]), any shape.
+        resolved_variance: σ_r², its variance (same unit squared), ≥ 0.
+        total_variance: σ_X², the variance of the whole synthesized field, ≥ 0 (values below σ_r²
+            are taken as σ_r²: nothing unresolved).
+        whitecap_fraction: W in [0, 1], the area fraction of the mean model.
+        floor: ρ ≥ 0, the smallest σ_u as a fraction of σ_X (ρ = 0 only with σ_r² < σ_X² everywhere).
+    All broadcast together (e.g. X_r (B, H, W), σ_X² and W of shape (B, 1, 1)); float32/float64 and
+    device follow the inputs; differentiable in all four.
+
+    Returns:
+        f_pix in [0, 1], the broadcast shape.
+
+    Example:
+        >>> import torch
+        >>> x = torch.tensor([-1.0, 0.0, 2.0, 3.0])
+        >>> f = crest_foam_fraction(x, torch.tensor(1.0), torch.tensor(1.1), torch.tensor(0.01))
+        >>> [round(v, 3) for v in f.tolist()]
+        [0.0, 0.0, 0.084, 0.959]
+        >>> round(float(crest_foam_fraction(0.0, 0.0, 1.1, 0.01)), 6)  # nothing resolved: W
+        0.01
+    """
+    check_finite_range("crest", crest)
+    check_finite_range("resolved_variance", resolved_variance, 0.0, math.inf, hi_open=True)
+    check_finite_range("total_variance", total_variance, 0.0, math.inf, hi_open=True)
+    check_finite_range("whitecap_fraction", whitecap_fraction, 0.0, 1.0)
+    if not (isinstance(floor, (int, float)) and not isinstance(floor, bool) and math.isfinite(floor) and floor >= 0):
+        raise ValueError(f"floor must be a finite float ≥ 0; got {floor!r}")
+    dtype, device = resolve_dtype_device(
+        crest=crest, resolved_variance=resolved_variance, total_variance=total_variance,
+        whitecap_fraction=whitecap_fraction,
+    )
+    x = as_tensor(crest, dtype, device)
+    v_r = as_tensor(resolved_variance, dtype, device)
+    v_t = as_tensor(total_variance, dtype, device)
+    w = as_tensor(whitecap_fraction, dtype, device)
+    v_u = torch.clamp(v_t - v_r, min=0.0) + (floor * floor) * v_t
+    known = v_u > 0  # False only without crest variance at all (or ρ = 0 and nothing unresolved)
+    v_u = torch.where(known, v_u, torch.ones_like(v_u))
+    inner = w < 1.0
+    w_q = torch.where(inner, torch.clamp(w, min=_W_MIN), torch.full_like(w, 0.5))
+    q = -torch.special.ndtri(w_q)  # Φ⁻¹(1 − W), accurate for small W (no 1 − W rounding)
+    z = (x - q * torch.sqrt(v_r + v_u)) * torch.rsqrt(v_u)
+    f = 0.5 * torch.erfc(-z * _SQRT_HALF)  # Φ(z), accurate in the lower tail (torch.special.ndtr is not)
+    f = torch.where(w < _W_MIN, f * (w / _W_MIN), f)  # exactly 0 at W = 0, mean still W
+    f = torch.where(known, f, w)
+    return torch.where(inner, f, torch.ones_like(f))
