@@ -186,10 +186,11 @@ def view_geometry(
     return out
 
 
-def _component(a: torch.Tensor, x: torch.Tensor, y: torch.Tensor, inv: torch.Tensor) -> torch.Tensor:
+def _component(a: torch.Tensor, x: torch.Tensor, y: torch.Tensor, inv: torch.Tensor | None) -> torch.Tensor:
     """a · (x, y, 1) / |(x, y, 1)|: a world axis ``a`` (b, 3, ...) in camera axes against the unit ray
     of normalized image coordinates (x, y) (``inv`` = 1/|(x, y, 1)|), broadcast over (x, y)."""
-    return ((a[:, 0] * x + a[:, 2]) + a[:, 1] * y) * inv
+    out = (a[:, 0] * x + a[:, 2]) + a[:, 1] * y
+    return out if inv is None else out * inv
 
 
 class CameraGeometry:
@@ -231,9 +232,13 @@ class CameraGeometry:
             self.s_h = (torch.sqrt(alt * (2 * Re + alt)) / (Re + alt)).to(dtype)  # sine of the horizon dip
             self.num = (alt * (2 * Re + alt) / (Re + alt)).to(dtype)  # h (2R + h)/(R + h) [m]
 
-    def ray_components(self, sl: slice, need_xy: bool = True) -> tuple[torch.Tensor, ...]:
+    def ray_components(self, sl: slice, need_xy: bool = True,
+                       azimuth_offset: torch.Tensor | None = None) -> tuple[torch.Tensor, ...]:
         """World components of the unit ray of every pixel of the cameras ``sl``, each (b, H, W): dz
         along the local vertical and, with ``need_xy``, dx and dy along world x and y (else None).
+        With ``azimuth_offset`` (b,) [rad], only (c, s): the ray's components along the world x and
+        y axes turned by −offset (so that atan2(s, c) = the ray's azimuth + offset), unnormalized
+        (a positive scale per pixel), for the ray's azimuth alone.
 
         Pixel rays come from kornia's unprojection. For a pinhole without skew the normalized ray
         (x, y, 1) has x depending on the column only and y on the row only, so kornia unprojects one
@@ -244,6 +249,9 @@ class CameraGeometry:
         H, W = self.H, self.W
         K = self.cameras.camera_matrix[sl].to(self.dtype)
         A = self.axes_cam[sl]  # (b, 3 components, 3 camera axes)
+        if azimuth_offset is not None:  # x' = cos o x − sin o y, y' = sin o x + cos o y
+            co, so = torch.cos(azimuth_offset)[:, None], torch.sin(azimuth_offset)[:, None]
+            A_t = torch.stack([co * A[:, 0] - so * A[:, 1], so * A[:, 0] + co * A[:, 1]], 1)
         if bool((K[:, 0, 1] == 0).all()):
             b_ = K.shape[0]
             u = torch.arange(W, dtype=self.dtype, device=self.device)
@@ -255,13 +263,18 @@ class CameraGeometry:
             inv = torch.rsqrt(x * x + (y * y + 1.0))  # one full-size add
 
             def comp(i: int) -> torch.Tensor:
+                if i < 2 and azimuth_offset is not None:  # unnormalized, along the turned axes
+                    return _component(A_t[:, i, :, None, None], x, y, None)
                 return _component(A[:, i, :, None, None], x, y, inv)
         else:
             rays = unproject_meshgrid(H, W, K, normalize_points=True, device=self.device, dtype=self.dtype)
 
             def comp(i: int) -> torch.Tensor:
-                return (rays * A[:, i, None, None, :]).sum(-1)
+                a = A_t[:, i] if i < 2 and azimuth_offset is not None else A[:, i]
+                return (rays * a[:, None, None, :]).sum(-1)
 
+        if azimuth_offset is not None:
+            return comp(0), comp(1)
         return (comp(2), comp(0), comp(1)) if need_xy else (comp(2), None, None)
 
     def pixels(self, sl: slice, need_xy: bool = True) -> dict[str, torch.Tensor]:
