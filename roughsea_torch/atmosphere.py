@@ -425,9 +425,12 @@ class AtmosphericPath:
         _, nodes, lev, has_lev, g0, g1, l0, l1 = self._tensors(dtype, device)
         i = torch.searchsorted(nodes, h.detach().contiguous(), right=True).clamp(1, nodes.numel() - 1) - 1
         fi = i.to(dtype)
-        x0 = fi + (log_h - l0[i]) / (l1[i] - l0[i])
-        g = torch.where(has_lev[i], torch.log((h - lev[i]).clamp_min(0.0) + self._offset), log_h)
-        x1 = fi + (g - g0[i]) / (g1[i] - g0[i])
+        # index_select on the flat indices: advanced indexing costs ~4x more on the CPU
+        L0, L1, G0, G1, LEV, HAS = (t.index_select(0, i.reshape(-1)).reshape(i.shape)
+                                    for t in (l0, l1, g0, g1, lev, has_lev))
+        x0 = fi + (log_h - L0) / (L1 - L0)
+        g = torch.where(HAS, torch.log((h - LEV).clamp_min(0.0) + self._offset), log_h)
+        x1 = fi + (g - G0) / (G1 - G0)
         return x0, x1
 
     def __call__(self, altitude_m: Any, range_m: Any, *, clamp: bool = False) -> tuple[torch.Tensor, torch.Tensor]:

@@ -945,15 +945,19 @@ def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Te
         reach = sun.radius[:, None, None] * 2.0 * (1 + sgx * sgx + sgy * sgy) / qz.clamp_min(1e-6) / torch.sqrt(lam_min)
         keep = sea & (wz > 0) & (torch.sqrt(d2) - reach < 6.0)
     out = torch.zeros_like(cos_t)
-    if not bool(keep.any()):
+    flat = keep.reshape(-1).nonzero().squeeze(1)  # the kept pixels' flat indices, found once
+    if flat.numel() == 0:
         return out
-    img = torch.arange(b_, device=device)[:, None, None].expand_as(keep)[keep]
-    c_k = cos_t[keep]
-    phi = torch.atan2(-dy[keep], -dx[keep]) - p["wind_direction"][sl][img]
-    slopes = SlopeStatistics.from_variances(p["vx"][sl][img], p["vy"][sl][img], p["cxy"][sl][img])
+    # gathers by index_select on flat indices (boolean-mask or advanced indexing costs ~4x more)
+    at = lambda t: t.reshape(-1).index_select(0, flat)  # noqa: E731  (a (b, H, W) field at the kept pixels)
+    img = torch.div(flat, H * W, rounding_mode="floor")
+    per = lambda t: t[sl].index_select(0, img)  # noqa: E731  (a (B,) scene field at the kept pixels)
+    c_k, dx_k, dy_k = at(cos_t), at(dx), at(dy)
+    phi = torch.atan2(-dy_k, -dx_k) - per(p["wind_direction"])
+    slopes = SlopeStatistics.from_variances(per(p["vx"]), per(p["vy"]), per(p["cxy"]))
     from .sun import Sun, sun_masking_factor
 
-    s_k = Sun(sun.zenith[img], sun.azimuth[img], sun.irradiance[img], sun.radius[img])
+    s_k = Sun(*(v.index_select(0, img) for v in (sun.zenith, sun.azimuth, sun.irradiance, sun.radius)))
     masking = scene.sun_masking
     if resolved is not None:
         # the sun is masked by all the waves: the G1 of the total law (see sun_masking_factor)
@@ -961,19 +965,19 @@ def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Te
         masking = False
         from .clutter import along_view, two_scale_statistics
 
-        inv = torch.rsqrt((dx[keep] ** 2 + dy[keep] ** 2).clamp_min(1e-30))
-        var_a, kap = along_view(tuple(c[keep] for c in resolved[1]), -dx[keep] * inv, -dy[keep] * inv)
+        inv = torch.rsqrt((dx_k ** 2 + dy_k ** 2).clamp_min(1e-30))
+        var_a, kap = along_view(tuple(at(c) for c in resolved[1]), -dx_k * inv, -dy_k * inv)
         slopes = _squeeze_last(two_scale_statistics(slopes.var_upwind, slopes.var_crosswind, slopes.cov, phi, c_k,
-                                                    resolved[0][keep][:, None], var_a, kap))
-    g = glint_radiance(torch.acos(c_k.clamp(-1.0, 1.0)), phi, slopes, (p["n"][sl][img], p["k"][sl][img]), s_k,
+                                                    at(resolved[0])[:, None], var_a, kap))
+    g = glint_radiance(torch.acos(c_k.clamp(-1.0, 1.0)), phi, slopes, (per(p["n"]), per(p["k"])), s_k,
                        scene.shadowing, masking)
     if resolved is not None and g1 is not None:
         g = g * g1
     if scene.path is not None:
-        h = altitude[sl].to(dtype)[img]
+        h = per(altitude.to(dtype))
         tau, _ = scene.path(h, _slant_range(c_k, h, earth_radius_m), clamp=True)
         g = g * tau.to(dtype)
-    return out.index_put((keep,), g)
+    return out.reshape(-1).index_put((flat,), g).reshape(out.shape)
 
 
 def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str, Any], scene: SeaScene,
@@ -1227,6 +1231,7 @@ def _render_table(
         k_sea, b_sea, k_sky, b_sky = (v.to(dtype)[:, None, None] for v in (k_sea, b_sea, k_sky, b_sky))
         if geometry is not None:
             cos, sea = geometry.cos_view_zenith[sl], geometry.is_sea[sl]
+            seaf = sea.to(dtype)
             dx, dy = geometry._dx[sl], geometry._dy[sl]
             zeta = _asinh((cos * inv_eps[sl, None, None]).clamp_min(0.0))
         else:  # ζ straight from the ray's vertical component dz: cos θ̂ / ε = (k_r/ε) √((dz + s_h)(dz − s_h))
@@ -1239,14 +1244,17 @@ def _render_table(
             sh = cg.s_h[sl, None, None] if not cg.flat else torch.zeros_like(c1)
             # q = (cos θ̂/ε)² = c1² (dz² − s_h²); sky pixels (unused) and the horizon row are held at
             # a tiny q > 0, which keeps √'s gradient finite
-            sea = cos < -sh
+            # the sea mask as 1/0 in the image dtype, written by the compare (a bool → float copy costs
+            # ~6 compares); as bool only where the texture or the glint needs it
+            seaf = torch.lt(cos.detach(), -sh.detach(), out=torch.empty(cos.shape, dtype=dtype, device=device))
+            sea = seaf.bool() if (textured or sunny) else None
             q_ = torch.addcmul(-(c1 * sh) ** 2, cos, cos * (c1 * c1)).clamp_min(1e-30)
             # asinh √q as a log: torch.asinh is ~20x slower on the CPU
             zeta = torch.log(torch.sqrt(q_) + torch.sqrt(q_ + 1.0))
         gy = torch.addcmul(b_sea, zeta, k_sea)
         if has_sky:  # cos: the sky pixels' cos of the ray's zenith (dz); lerp by weight 0 or 1 is an
             # exact select, and costs an eighth of torch.where on the CPU
-            gy = torch.lerp(torch.addcmul(b_sky, cos, k_sky), gy, sea.to(dtype))
+            gy = torch.lerp(torch.addcmul(b_sky, cos, k_sky), gy, seaf)
         if iso:
             gx = torch.zeros_like(gy)
         else:

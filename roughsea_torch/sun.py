@@ -42,7 +42,7 @@ __all__ = ["Sun", "SUN_RADIUS", "glint_radiance", "sun_masking_factor"]
 
 SUN_RADIUS = math.radians(0.2666)  # angular radius of the sun's disk at 1 AU [rad]
 _SQRT_HALF = math.sqrt(0.5)
-_SMALL_ELLIPSE = 0.01  # tr K⁻¹ below which the glint's ellipse takes the second-order closed form
+_SMALL_ELLIPSE = 0.1  # tr K⁻¹ below which the glint's ellipse takes the fourth-order closed form
 _N_RAYS = 48  # rays from the mean over the ellipse (Gauss–Legendre, or uniform when the mean is inside)
 
 
@@ -103,17 +103,27 @@ def _ellipse_probability(cx: torch.Tensor, cy: torch.Tensor, k11: torch.Tensor, 
 
 def _small_ellipse(cx: torch.Tensor, cy: torch.Tensor, k11: torch.Tensor, k12: torch.Tensor, k22: torch.Tensor,
                    det_k: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """A small ellipse E' = {c + w : wᵀ K w ≤ 1}: expanding φ₂(c + w) to second order in w over it,
-    P = area φ₂(c) [1 + (cᵀ S c − tr S)/8] and ∫ z φ₂ = area φ₂(c) [c (1 + (cᵀ S c − tr S)/8) − S c/4]
-    (S = K⁻¹, area = π √det S); the next terms are O(|S|² |c|⁴)/192, below 1e-6 where tr S < 0.01
-    and |c| < 9."""
+    """A small ellipse E' = {c + w : wᵀ K w ≤ 1}, S = K⁻¹, area π √det S. The mean of a function over
+    the ellipse is Σₙ (Δ_S/4)ⁿ f(c) / (n! (n+1)!) (Δ_S = ∇ᵀ S ∇; the uniform disk's moment series),
+    here to n = 2. With g = cᵀSc − tr S and T = g² + 2 tr S² − 4 cᵀS²c:
+    P = area φ₂(c) F, F = 1 + g/8 + T/192, and
+    ∫ z φ₂ = area φ₂(c) [c F − S c (1/4 + g/48) + S² c/24].
+    Against a 1024-ray integration over 2e5 random ellipses (axis ratios to 30, |c| < 6.5), for
+    tr S < 0.1: 1.4e-6 of the peak area φ₂(0) (P) and 4e-6 (moment), 6e-5 relative where |c| < 4;
+    the 48-ray rule is 1e-3 off on the same (thin) ellipses. (To n = 1, the earlier rule, it was
+    1.4e-4 of the peak there.)"""
     s11, s12, s22 = k22 / det_k, -k12 / det_k, k11 / det_k
     area = math.pi * torch.rsqrt(det_k)
     phi = torch.exp(-0.5 * (cx * cx + cy * cy)) / (2.0 * math.pi)
-    csc = cx * (s11 * cx + s12 * cy) + cy * (s12 * cx + s22 * cy)
-    f = 1.0 + (csc - (s11 + s22)) / 8.0
+    scx, scy = s11 * cx + s12 * cy, s12 * cx + s22 * cy
+    g = cx * scx + cy * scy - (s11 + s22)
+    s2x, s2y = s11 * scx + s12 * scy, s12 * scx + s22 * scy
+    t2 = g * g + 2.0 * (s11 * s11 + 2.0 * s12 * s12 + s22 * s22) - 4.0 * (scx * scx + scy * scy)
+    f = 1.0 + g / 8.0 + t2 / 192.0
     base = area * phi
-    return (base * f).clamp(0.0, 1.0), base * (cx * f - (s11 * cx + s12 * cy) / 4.0), base * (cy * f - (s12 * cx + s22 * cy) / 4.0)
+    a = 0.25 + g / 48.0
+    return ((base * f).clamp(0.0, 1.0), base * (cx * f - a * scx + s2x / 24.0),
+            base * (cy * f - a * scy + s2y / 24.0))
 
 
 def _ellipse_probability_rays(cx: torch.Tensor, cy: torch.Tensor, k11: torch.Tensor, k12: torch.Tensor,

@@ -106,6 +106,20 @@ def test_ellipse_probability_against_closed_forms():
     assert abs(float(p) / want - 1) < 1e-6
 
 
+def test_small_ellipse_closed_form_against_the_noncentral_chi_square():
+    """A disk of radius 0.2 (tr S = 0.08, inside the closed form's range) at several distances from
+    the mean: its Gaussian mass is the noncentral χ² CDF with 2 degrees of freedom (scipy), to 1e-6
+    relative; the second-order rule alone (the earlier one) is 2e-5 to 5e-4 off here."""
+    from scipy.stats import ncx2
+
+    t = lambda v: torch.tensor(v, dtype=torch.float64)  # noqa: E731
+    r = 0.2
+    for c in ((1.5, -0.7), (2.5, 1.0), (0.3, 0.2), (3.5, 0.0)):
+        p, _, _ = _ellipse_probability(t(c[0]), t(c[1]), t(1 / r**2), t(0.0), t(1 / r**2), t(1 / r**4))
+        want = ncx2.cdf(r * r, 2, c[0] ** 2 + c[1] ** 2)
+        assert abs(float(p) / want - 1) < 1e-6
+
+
 def test_sun_masking_is_smith_g1():
     """sun_masking multiplies by Smith's G1 = 1/(1 + Λ(θ_sun)) (zero-mean slopes), Λ in closed form."""
     var = 0.003 + 5.12e-3 * 12
