@@ -260,7 +260,8 @@ class CameraGeometry:
             col = torch.stack([torch.zeros_like(v), v], -1).expand(b_, H, 2)
             x = normalize_points_with_intrinsics(row, K)[..., 0][:, None, :]  # (b, 1, W)
             y = normalize_points_with_intrinsics(col, K)[..., 1][:, :, None]  # (b, H, 1)
-            inv = torch.rsqrt(x * x + (y * y + 1.0))  # one full-size add
+            # 1/|(x, y, 1)|: one full-size add (not for the unnormalized turned components)
+            inv = None if azimuth_offset is not None else torch.rsqrt(x * x + (y * y + 1.0))
 
             def comp(i: int) -> torch.Tensor:
                 if i < 2 and azimuth_offset is not None:  # unnormalized, along the turned axes
