@@ -12,9 +12,11 @@ clouds or rain), the *directly transmitted* solar spectral irradiance at sea lev
 to the beam [W m⁻² m⁻¹, per metre of wavelength], 700–3455 cm⁻¹ in 5 cm⁻¹ steps
 (2.894–14.286 µm), against the sun's apparent zenith angle 0–90° (LOWTRAN's ``IEMSCT = 3``,
 observer at 0 km looking at the sun along a refracted path to space, mean Sun–Earth distance), and
-LOWTRAN's extraterrestrial solar spectrum (the same, without the atmosphere). Not included: the
-sunlight scattered by the air into the rest of the sky, and aerosol extinction (which dims the
-direct beam further, most in MWIR).
+LOWTRAN's extraterrestrial solar spectrum (the same, without the atmosphere). Not included by
+default: aerosol extinction (which dims the direct beam further, most in MWIR; optional with
+``load_solar_irradiance(..., aerosol="maritime")``, LOWTRAN's aerosol transmittance from
+``solar_direct_aerosol.npz``) and the sunlight scattered into the rest of the sky
+(:mod:`roughsea_torch.daysky`).
 
 The zenith angle is the *apparent* one (refracted, as seen from the sea); pvlib's
 ``apparent_zenith`` (what :func:`sun_position` returns). The two differ by ≤ 0.1° above 80° and by
@@ -207,6 +209,7 @@ def load_solar_irradiance(
     dtype: torch.dtype = torch.float64,
     *,
     distance_au: float = 1.0,
+    aerosol: str | None = None,
     data_dir: str | Path | None = None,
 ) -> SolarIrradiance:
     """Direct solar band irradiance at sea level, normal to the beam, of a LOWTRAN atmosphere.
@@ -218,6 +221,12 @@ def load_solar_irradiance(
             as in :func:`roughsea_torch.atmosphere.load_sky`.
         dtype: torch.float32 or torch.float64, for integer queries.
         distance_au: Sun–Earth distance [AU] (0.983–1.017 over the year); scales by 1/d².
+        aerosol: None (default: the table as is, no aerosol) or one of
+            :data:`roughsea_torch.daysky.AEROSOLS` (``"maritime"``, ``"rural"``, 23 km): the beam is
+            also dimmed by that aerosol's transmittance, LOWTRAN7 ``IEMSCT = 3`` with ``IHAZE`` set
+            (:func:`roughsea_torch.daysky.direct_aerosol_transmittance`, applied per wavenumber and
+            sun-zenith node before the band integral), consistent with
+            :func:`roughsea_torch.daysky.load_scattered_sky`'s aerosols.
 
     Returns:
         A :class:`SolarIrradiance`: ``e(sun_zenith_rad)`` → ∫ E_λ r dλ [W m⁻²], the sun's apparent
@@ -226,8 +235,8 @@ def load_solar_irradiance(
         :func:`solar_provenance`.
 
     Raises:
-        ValueError: unknown atmosphere, a band outside the table's wavelengths, a bad response,
-            dtype or distance.
+        ValueError: unknown atmosphere or aerosol, a band outside the table's wavelengths, a bad
+            response, dtype or distance.
     """
     from .atmosphere import spectral_weights  # the same band integration as the sky tables
 
@@ -241,7 +250,12 @@ def load_solar_irradiance(
     b = _band(band, response, nu)
     w = spectral_weights(1e-2 / nu, b)
     scale = 1.0 / float(distance_au) ** 2
-    values = t["direct_irradiance"][i].astype(np.float64) @ w * scale
+    direct = t["direct_irradiance"][i].astype(np.float64)
+    if aerosol is not None:
+        from .daysky import direct_aerosol_transmittance  # solar_direct_aerosol.npz, same nodes
+
+        direct = direct * direct_aerosol_transmittance(atmosphere, aerosol, data_dir=data_dir)
+    values = direct @ w * scale
     toa = float(t["toa_irradiance"].astype(np.float64) @ w) * scale
     return SolarIrradiance(atmosphere, b, t["sun_zenith_rad"], values, toa, dtype)
 
