@@ -281,7 +281,7 @@ class TextureTable:
         included; None when no node of the chunk resolves any wave."""
         from .expectation import _reflection_terms
         from .render import _sky_per_image, _slant_range
-        from .sky import select_sky
+        from .sky import TabulatedSky, select_sky
 
         dtype, device = self.dtype, self.device
         # the texture's own ζ nodes over the sea rows' span (it varies faster in ζ than the mean:
@@ -319,7 +319,11 @@ class TextureTable:
                                                                     (shifted.var_crosswind, vy[img, 0, 0]),
                                                                     (shifted.cov, cxy[img, 0, 0])))
         ).shifted(*(torch.cat([m, torch.zeros_like(m[:, :1])], 1) for m in (shifted.mean_upwind, shifted.mean_crosswind)))
-        sky_m = _sky_per_image(select_sky(sky_of_chunk(sky, b_), img.cpu()), img.numel(), dtype, device, 1)
+        if isinstance(sky, TabulatedSky) and sky.radiance.ndim == 4 and sky.radiance.shape[2] > 1:
+            # a sky per azimuth node (by day: the scattered sky along each node's mirror azimuth)
+            sky_m = sky.with_radiance(sky.radiance[:, 0].to(dtype=dtype, device=device)[img, idx[2]][:, None, :])
+        else:
+            sky_m = _sky_per_image(select_sky(sky_of_chunk(sky, b_), img.cpu()), img.numel(), dtype, device, 1)
         outer, inner = self.quadrature
         t_s, t_rho, _ = _reflection_terms(torch.acos(ct.clamp(-1.0, 1.0))[:, None], ph[:, None], stats,
                                           (p["n"][sl][img, None], p["k"][sl][img, None]), sky_m, scene.shadowing,

@@ -105,7 +105,15 @@ class SeaScene:
             [rad] (floats or (B,)); its direct irradiance then comes from the shipped LOWTRAN7 table
             of the named atmosphere in the scene's band (:func:`roughsea_torch.solar.load_solar_irradiance`;
             a named ``sky`` is needed). :func:`roughsea_torch.solar.sun_position` gives them from a
-            date, time and place (pvlib); note its azimuth is from north, clockwise.
+            date, time and place (pvlib); note its azimuth is from north, clockwise. The sky
+            then gains the sunlight that the air's aerosol scatters into it (``aerosol``).
+        aerosol: the aerosol of a scene lit through ``sun_zenith=`` (LOWTRAN7's 23 km models:
+            ``"maritime"``, default, or ``"rural"``; ``None``: none): it dims the sun's beam and
+            scatters sunlight into the sky (:mod:`roughsea_torch.daysky`), which the sky pixels show
+            in full (by view zenith and azimuth from the sun) and the sea reflects, each reflected
+            ray taken at the mirror azimuth of its pixel's view (rays spread about it by the
+            slopes; the sky term of Eq. 10 integrates over zenith only). The thermal sky keeps
+            its tables (no aerosol). Not used with ``sun=`` or a sky that is not a named atmosphere.
         sun_masking: Smith's masking of the facets from the sun's side (default True).
         sky_masking: Smith's masking of the reflected ray on the sky term (default False, the paper's
             model; Mitsuba 3's rough surfaces include it): its masked part sees the sea.
@@ -150,6 +158,7 @@ class SeaScene:
         sun_masking: bool = True,
         sky_masking: bool = False,
         foam: Any = "auto",
+        aerosol: Any = "maritime",
     ):
         if (slopes is None) == (wind_speed is None):
             raise ValueError("SeaScene: give exactly one of slopes= or wind_speed=")
@@ -224,6 +233,13 @@ class SeaScene:
                                  "give sky='<name>', or sun=rs.Sun(zenith, azimuth, irradiance) with your own irradiance")
             check_finite_range("sun_zenith", sun_zenith, 0.0, math.pi, unit="rad")
             check_finite_range("sun_azimuth", sun_azimuth, unit="rad")
+        if aerosol is not None:
+            from .daysky import AEROSOLS
+
+            if aerosol not in AEROSOLS:
+                raise ValueError(f"aerosol must be None or one of {list(AEROSOLS)}; got {aerosol!r}")
+        self.aerosol = aerosol
+        self._day_skies: dict[Any, Any] = {}
         self._sun = sun
         self.sun_zenith, self.sun_azimuth = sun_zenith, sun_azimuth
         self.sun_masking = sun_masking
@@ -250,7 +266,8 @@ class SeaScene:
         from .solar import load_solar_irradiance
         from .sun import Sun
 
-        e = load_solar_irradiance(self.atmosphere, (self.band.lo, self.band.hi), self.band.response)
+        e = load_solar_irradiance(self.atmosphere, (self.band.lo, self.band.hi), self.band.response,
+                                  aerosol=self.aerosol)
         z = self.sun_zenith
         zt = z.double() if isinstance(z, torch.Tensor) else torch.tensor(float(z), dtype=torch.float64)
         irr = e(zt)
@@ -261,6 +278,21 @@ class SeaScene:
     @sun.setter
     def sun(self, value: Any) -> None:
         self._sun, self.sun_zenith = value, None
+
+    @property
+    def day_sky(self) -> Any:
+        """The solar-scattered sky (:class:`roughsea_torch.daysky.ScatteredSky`) of a scene lit
+        through ``sun_zenith=`` with a named atmosphere and an ``aerosol``; else None."""
+        if self.sun_zenith is None or self._sun is not None or self.atmosphere is None or self.aerosol is None:
+            return None
+        key = (self.atmosphere, self.aerosol, self.band)
+        if key not in self._day_skies:
+            from .daysky import load_scattered_sky
+
+            self._day_skies.clear()
+            self._day_skies[key] = load_scattered_sky(self.atmosphere, (self.band.lo, self.band.hi),
+                                                      aerosol=self.aerosol, response=self.band.response)
+        return self._day_skies[key]
 
     @property
     def observer_sky(self) -> Any:
@@ -417,6 +449,11 @@ class TableSize:
         zenith_thin: nodes in ζ when a slope ellipse is thin (its grazing layer then changes
             sharply with azimuth, and the spans read from the cameras' border start at the
             horizon, ζ = 0): W = 0 along the wind, 1.3e-4 with 21 nodes, 7e-6 with 41.
+        azimuth_day: nodes in relative azimuth when the sea reflects a scattered daytime sky
+            (``SeaScene(aerosol=)``): it has the aerosol's forward-scattering peak about the sun and is
+            tabulated piecewise linearly in azimuth (:mod:`roughsea_torch.daysky`), so Chebyshev
+            nodes converge slowly: MWIR, sun 20° up ahead, 20 m mast at 2° down, against per-pixel
+            evaluation: 7 nodes 1.9e-3, 13 2.3e-4, 25 3.7e-5.
         zenith_narrow: nodes in ζ when some image's slope ellipse is narrow but not thin (minor/major
             rms slope < 0.5: Cox–Munk below ~0.3 m/s): views along the wind at W = 0.05 m/s,
             2.9e-5 with 17 nodes, 1.4e-5 with 21.
@@ -459,11 +496,13 @@ class TableSize:
     fine_texture_azimuth: int = 16
     texture_quadrature: tuple = (20, 16)
     zenith_narrow: int = 21
+    azimuth_day: int = 25
 
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):
             raise ValueError(f"TableSize.span must be 'pixels' or 'full'; got {self.span!r}")
-        for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin", "zenith_narrow", "texture", "texture_zenith"):
+        for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin", "zenith_narrow", "azimuth_day", "texture",
+                     "texture_zenith"):
             if int(getattr(self, name)) < 2:
                 raise ValueError(f"TableSize.{name} must be >= 2")
         for name in ("fine_zenith", "fine_azimuth", "fine_sky", "fine_azimuth_thin", "fine_texture",
@@ -571,8 +610,8 @@ def _azimuth_ratio(c: torch.Tensor, s: torch.Tensor, fold: bool) -> torch.Tensor
         num = c.abs()
         den = (num + s.abs()).clamp_min_(1e-30)
         return num / den
-    num = torch.copysign(c, s)
-    den = (num.abs() + s.abs()).clamp_min_(1e-30)
+    num = c * torch.copysign(torch.ones_like(s), s)  # c · sign s (sign +1 at s = +0)
+    den = (c.abs() + s.abs()).clamp_min_(1e-30)
     return -num / den
 
 
@@ -810,6 +849,9 @@ def render(
             if scene.sun is not None:
                 sky_pix = sky_pix + _sun_disk_pixels(scene, B, slice(None), geom.cos_view_zenith, geom._dx, geom._dy, ~sea,
                                                      1.0 / cameras.fx.to(dtype))
+            day = _day(scene, B, dtype, device)
+            if day is not None:
+                sky_pix = sky_pix + _day_sky_pixels(day, slice(None), geom.cos_view_zenith, geom._dx, geom._dy)
             img = sky_pix if img is None else torch.where(sea, img, sky_pix)
         img = img.reshape(B, 1, H, W)
         if output == "brightness_temperature":
@@ -836,6 +878,9 @@ def _sea_direct(geom: ViewGeometry, p: dict[str, Any], scene: SeaScene, q: Quadr
     ph = _relative_azimuth(geom, p)[sea]
     slopes = SlopeStatistics.from_variances(p["vx"][img_idx], p["vy"][img_idx], p["cxy"][img_idx])
     sky = select_sky(p["sky"], img_idx.cpu())
+    day = _day(scene, B, dtype, device)
+    if day is not None:  # the sky each pixel reflects, along its mirror azimuth
+        sky = _sky_with_day(sky, day, p, img_idx, ph)
     vals = apparent_radiance(
         th, ph, slopes, (p["n"][img_idx], p["k"][img_idx]), sea_radiance=p["rb"][img_idx], sky=sky,
         shadowing=scene.shadowing, quadrature=q, sun=_relative_sun(scene, p, B, dtype, device, img_idx),
@@ -857,6 +902,12 @@ def _foam_radiance(theta: torch.Tensor, p: dict[str, Any], idx: Any, scene: SeaS
     e_sky = torch.as_tensor(sky_hemispherical_mean(sky, dtype=dtype, device=device), dtype=dtype, device=device)
     if p["air_scale"] is not None:
         e_sky = e_sky * p["air_scale"][idx].to(dtype)
+    day = _day(scene, p["vx"].shape[0], dtype, device)
+    if day is not None:  # + the scattered sky's cosine-weighted mean, 2 ∫ <L>_φ(c) c dc (Gauss–Legendre)
+        x, w = np.polynomial.legendre.leggauss(24)
+        c = torch.as_tensor((x + 1) / 2, dtype=dtype, device=device)
+        wc = torch.as_tensor(w, dtype=dtype, device=device) * c
+        e_sky = e_sky + (day[0].azimuthal_mean(c, day[1][idx].to(dtype)[..., None]) * wc).sum(-1)
     extra = (None,) * (theta.ndim - 1) if not isinstance(idx, torch.Tensor) else ()
     if e_sky.ndim:
         e_sky = e_sky[(...,) + extra]
@@ -908,6 +959,44 @@ def _relative_sun(scene: SeaScene, p: dict[str, Any], B: int, dtype: torch.dtype
 
     z, a, e, r = _sun_fields(scene, B, dtype, device)
     return Sun(z[idx], a[idx] - p["wind_direction"][idx], e[idx], r[idx])
+
+
+def _day(scene: SeaScene, B: int, dtype: torch.dtype, device: torch.device) -> Any:
+    """(scattered sky, sun zenith (B,), sun world azimuth (B,)) of a scene whose sky gains the
+    sunlight its aerosol scatters (:attr:`SeaScene.day_sky`), else None."""
+    day = scene.day_sky
+    if day is None:
+        return None
+    z, a, _, _ = _sun_fields(scene, B, dtype, device)
+    return day, z, a
+
+
+def _sky_with_day(sky: TabulatedSky, day: tuple, p: dict[str, Any], idx: Any, view_azimuth: torch.Tensor) -> TabulatedSky:
+    """The sky the sea reflects by day, per element of ``view_azimuth`` (relative to upwind, LOS sea →
+    sensor; leading dim = the images ``idx``): the thermal table plus the scattered sky at its zenith
+    nodes along the mirror azimuth φ̂ + π (divided by the air-temperature scale that the sky term
+    gets afterwards, which is the thermal sky's)."""
+    ds, z_sun, a_sun = day
+    dtype, device = view_azimuth.dtype, view_azimuth.device
+    extra = (None,) * (view_azimuth.ndim - 1)
+    rel = view_azimuth + math.pi - (a_sun[idx] - p["wind_direction"][idx]).to(dtype)[(...,) + extra]
+    z = sky.zenith.to(dtype=dtype, device=device)
+    scat = ds(torch.cos(z), rel[..., None], z_sun[idx].to(dtype)[(...,) + extra + (None,)])
+    if p["air_scale"] is not None:
+        scat = scat / p["air_scale"][idx].to(dtype)[(...,) + extra + (None,)]
+    thermal = sky.radiance.to(dtype=dtype, device=device)
+    if thermal.ndim > 1:
+        thermal = thermal.reshape(thermal.shape[0], *([1] * (view_azimuth.ndim - 1)), thermal.shape[-1])
+    return sky.with_radiance(thermal + scat)
+
+
+def _day_sky_pixels(day: tuple, sl: Any, cos: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor) -> torch.Tensor:
+    """The scattered sky along the rays of sky pixels (cos of the ray's zenith, world x/y components;
+    rays below the horizontal see it at the horizontal), (b, H, W)."""
+    ds, z_sun, a_sun = day
+    extra = (slice(None), None, None)
+    rel = torch.atan2(dy, dx) - a_sun[sl].to(cos.dtype)[extra]
+    return ds(cos.clamp(0.0, 1.0), rel, z_sun[sl].to(cos.dtype)[extra].expand_as(cos))
 
 
 def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Tensor, dx: torch.Tensor,
@@ -1004,9 +1093,12 @@ def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str
     th, ph = geom.view_zenith[sea], _relative_azimuth(geom, p)[sea]
     vx, vy, cxy = p["vx"][img_idx], p["vy"][img_idx], p["cxy"][img_idx]
     slopes = _squeeze_last(two_scale_statistics(vx, vy, cxy, ph, torch.cos(th), x[sea][:, None], var_a[sea], kap[sea]))
+    sky = select_sky(p["sky"], img_idx.cpu())
+    day = _day(scene, B, dtype, device)
+    if day is not None:  # the sky each pixel reflects, along its mirror azimuth
+        sky = _sky_with_day(sky, day, p, img_idx, ph)
     vals = apparent_radiance(th, ph, slopes, (p["n"][img_idx], p["k"][img_idx]), sea_radiance=p["rb"][img_idx],
-                             sky=select_sky(p["sky"], img_idx.cpu()), shadowing=scene.shadowing, quadrature=q,
-                             sky_masking=scene.sky_masking)
+                             sky=sky, shadowing=scene.shadowing, quadrature=q, sky_masking=scene.sky_masking)
     sun = _relative_sun(scene, p, B, dtype, device, img_idx)
     if sun is not None:  # the pixel's own glint, masked from the sun by the total law (sun_masking_factor)
         from .sun import glint_radiance, sun_masking_factor
@@ -1079,7 +1171,8 @@ def _render_table(
     # rms slope along the view, √(a² cos²φ̂ + b² sin²φ̂), → b |sin φ̂|: folded, the kink sits at an
     # end of the node interval instead of inside it, where Chebyshev nodes cannot resolve it
     # (views along the wind at W = 0 were off by 8e-4 with 9 nodes; pipelines/accuracy_pareto.py).
-    fold = not iso and bool((p["cxy"] == 0).all())
+    day = _day(scene, B, dtype, device)  # a day sky is not symmetric about the wind: no folding
+    fold = not iso and day is None and bool((p["cxy"] == 0).all())
     # ε: a quarter of the smallest rms slope of each image, so ζ resolves the grazing layer.
     lam_min = 0.5 * (p["vx"] + p["vy"] - torch.sqrt((p["vx"] - p["vy"]) ** 2 + 4 * p["cxy"] ** 2))
     eps = (0.25 * torch.sqrt(lam_min.detach().clamp_min(0.0))).clamp(1e-4, 0.05).double()
@@ -1090,6 +1183,8 @@ def _render_table(
     nz = (max(table.zenith, table.zenith_thin) if thin else max(table.zenith, table.zenith_narrow) if narrow
           else table.zenith)
     nphi = 1 if iso else max(table.azimuth, table.azimuth_thin) if thin else table.azimuth
+    if day is not None:
+        nphi = max(nphi, table.azimuth_day)
     xz, Lz, ez = _lobatto_interp(nz, table.fine_zenith)
     xz_t = torch.as_tensor(xz, dtype=torch.float64, device=device)
     Lz_t = torch.as_tensor(Lz, dtype=dtype, device=device)
@@ -1148,6 +1243,8 @@ def _render_table(
         va = ph_nodes[:, None, :].expand(b_, nz, nphi)
         slopes = SlopeStatistics.from_variances(p["vx"][sl, None, None], p["vy"][sl, None, None], p["cxy"][sl, None, None])
         sky = _sky_per_image(select_sky(p["sky"], sl), b_, dtype, device, 2)
+        if day is not None:  # per azimuth node: the scattered sky along the mirror azimuth
+            sky = _sky_with_day(select_sky(p["sky"], sl), day, p, sl, ph_nodes[:, None, :])
         t_s, t_rho, _ = _reflection_terms(vz, va, slopes, (p["n"][sl, None, None], p["k"][sl, None, None]), sky,
                                           scene.shadowing, q, None, scene.sky_masking)
         if p["air_scale"] is not None:
@@ -1279,6 +1376,8 @@ def _render_table(
             vals, foam_vals = vals[:, 0], vals[:, 1]
         else:
             vals = vals[:, 0]
+        if day is not None and has_sky:  # the scattered sky of the sky pixels, by zenith and azimuth
+            vals = vals + (1.0 - seaf) * _day_sky_pixels(day, sl, cos, dx, dy)
         resolved = None
         if textured and delta is not None:
             cos_t = eps[sl, None, None].to(dtype) * torch.sqrt(q_)

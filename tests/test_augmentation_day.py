@@ -50,8 +50,9 @@ def test_daytime_draws_come_after_the_others():
 
 def test_mwir_glint_ahead_is_much_brighter_than_by_night():
     """MWIR, 5 m/s, camera 20 m up looking 3° down, the sun 10° up straight ahead: the glint raises
-    the brightest pixel by > 10 K over the same draw by night; the sun behind the camera adds
-    nothing (its glint is out of view, the sky is the same)."""
+    the brightest pixel by > 10 K over the same draw by night; the sun behind the camera adds no
+    glint (out of view), only the sunlight the aerosol scatters into the sky (its sky pixels and
+    the sea's reflection of it): everywhere >= 0 and under 1 K (0.37 K measured), a tenth of the glint."""
     kw = dict(wind_speed=5.0, altitude_m=20.0, pitch_deg=-3.0, hfov_deg=20.0, band=rs.MWIR,
               output="brightness_temperature")
     x = torch.zeros(2, 1, H, W)
@@ -63,7 +64,7 @@ def test_mwir_glint_ahead_is_much_brighter_than_by_night():
     assert torch.equal(day._params["wave_seed"], night._params["wave_seed"])  # the same sea
     gain = yd.amax(dim=(1, 2, 3)) - yn.amax(dim=(1, 2, 3))
     assert bool((gain > 10.0).all()), gain
-    assert float((yb - yn).abs().max()) < 0.01
+    assert float((yb - yn).min()) >= -1e-4 and float((yb - yn).max()) < min(1.0, 0.1 * float(gain.min()))
 
 
 def test_day_draws_replay_bit_for_bit():
