@@ -676,17 +676,7 @@ class WaveField:
         Returns:
             (var_x, var_y, cov_xy), each of shape (B, ...), dimensionless world-frame slope moments.
         """
-        f = self._footprint_tensor(footprint)
-        if f.ndim == 0:
-            f = f.expand(self.batch_size)
-        if f.shape[0] != self.batch_size:
-            raise ValueError(
-                f"footprint: must have shape (B, ...) with B = {self.batch_size}; got {tuple(f.shape)}"
-            )
-        w2 = self.band_weights(f) ** 2  # (B, ..., n_bands)
-        flat = w2.reshape(self.batch_size, -1, self.n_bands)
-        cov = torch.bmm(flat, self._covariance)  # (B, P, 3)
-        cov = cov.reshape(*f.shape, 3)
+        cov = self._windowed(self._covariance, footprint)  # (B, ..., 3)
         return cov[..., 0], cov[..., 1], cov[..., 2]
 
     def band_elevation_variance(self) -> torch.Tensor:
@@ -718,9 +708,8 @@ class WaveField:
         Σ_o w_o(f)² V_o^X (shape (B, ...)); arguments as :meth:`elevation_variance`."""
         return self._windowed_variance(self._variance[..., 1], footprint)
 
-    def _windowed_variance(self, band_var: torch.Tensor, footprint: Any) -> torch.Tensor:
-        if footprint is None:
-            return band_var.sum(-1)
+    def _windowed(self, per_band: torch.Tensor, footprint: Any) -> torch.Tensor:
+        """Σ_o w_o(footprint)² · per_band[:, o, :] for per-band moments (B, n_bands, K): (B, ..., K)."""
         f = self._footprint_tensor(footprint)
         if f.ndim == 0:
             f = f.expand(self.batch_size)
@@ -730,7 +719,12 @@ class WaveField:
             )
         w2 = self.band_weights(f) ** 2  # (B, ..., n_bands)
         flat = w2.reshape(self.batch_size, -1, self.n_bands)
-        return torch.bmm(flat, band_var[:, :, None]).reshape(f.shape)
+        return torch.bmm(flat, per_band).reshape(*f.shape, per_band.shape[-1])
+
+    def _windowed_variance(self, band_var: torch.Tensor, footprint: Any) -> torch.Tensor:
+        if footprint is None:
+            return band_var.sum(-1)
+        return self._windowed(band_var[:, :, None], footprint)[..., 0]
 
     # -- evaluation ------------------------------------------------------------------------
     def _footprint_tensor(self, footprint: Any) -> torch.Tensor:
