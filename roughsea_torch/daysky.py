@@ -56,7 +56,7 @@ import torch.nn.functional as F
 
 from .atmosphere import ATMOSPHERES, _dir, spectral_weights
 from .radiometry import SpectralBand
-from .sun import SUN_RADIUS
+from .solar import disk_fraction
 
 __all__ = [
     "ATMOSPHERES",
@@ -219,18 +219,6 @@ def _refine(nodes: np.ndarray, r: int) -> np.ndarray:
     return np.concatenate([(nodes[:-1, None] + np.diff(nodes)[:, None] * k).ravel(), nodes[-1:]])
 
 
-def _disk_fraction(z: torch.Tensor) -> torch.Tensor:
-    """Visible fraction of a uniform solar disk whose centre is at apparent zenith z [rad]: 1 up to
-    90° − α, ½ at 90°, 0 from 90° + α (α = ``SUN_RADIUS``); finite gradient everywhere (as
-    :class:`roughsea_torch.solar.SolarIrradiance` dims the direct beam)."""
-    half_pi = math.pi / 2
-    eps = 1e-6 if z.dtype == torch.float64 else 1e-3
-    c = ((z - half_pi) / SUN_RADIUS).clamp(-1.0 + eps, 1.0 - eps)
-    frac = (torch.acos(c) - c * torch.sqrt(1.0 - c * c)) / math.pi
-    frac = torch.where(z <= half_pi - SUN_RADIUS, torch.ones_like(frac), frac)
-    return torch.where(z >= half_pi + SUN_RADIUS, torch.zeros_like(frac), frac)
-
-
 def _queries(args: tuple[tuple[str, Any], ...]) -> tuple[list[torch.Tensor], torch.dtype, torch.device]:
     """Query arguments as broadcast tensors of one float dtype (promoted from the floating tensor
     arguments; float64 if none) and one device."""
@@ -375,7 +363,7 @@ class ScatteredSky:
         ga = self._grid_coordinate(folded.clamp(0.0, math.pi), tables[2])
         grid = torch.stack([ga, gv, gs], dim=-1).reshape(1, -1, 1, 1, 3)
         log_l = F.grid_sample(tables[3], grid, mode="bilinear", padding_mode="border", align_corners=True)
-        return (torch.exp(log_l.reshape(-1)) * _disk_fraction(z)).reshape(shape)
+        return (torch.exp(log_l.reshape(-1)) * disk_fraction(z)).reshape(shape)
 
     def azimuthal_mean(self, cos_view_zenith: Any, sun_zenith: Any) -> torch.Tensor:
         """(1/π) ∫₀^π L dφ [W m⁻² sr⁻¹], the mean over relative azimuth, same conventions as calling.
@@ -394,7 +382,7 @@ class ScatteredSky:
         gs, gv = self._coordinates(mu, z, tables)
         grid = torch.stack([gv, gs], dim=-1).reshape(1, -1, 1, 2)
         log_m = F.grid_sample(tables[4], grid, mode="bilinear", padding_mode="border", align_corners=True)
-        return (torch.exp(log_m.reshape(-1)) * _disk_fraction(z)).reshape(shape)
+        return (torch.exp(log_m.reshape(-1)) * disk_fraction(z)).reshape(shape)
 
     def __repr__(self) -> str:
         return (f"ScatteredSky({self.atmosphere!r}, aerosol={self.aerosol!r}, "

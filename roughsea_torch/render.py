@@ -1242,8 +1242,9 @@ def _render_table(
         vz = th_nodes.to(dtype)[:, :, None].expand(b_, nz, nphi)
         va = ph_nodes[:, None, :].expand(b_, nz, nphi)
         slopes = SlopeStatistics.from_variances(p["vx"][sl, None, None], p["vy"][sl, None, None], p["cxy"][sl, None, None])
-        sky = _sky_per_image(select_sky(p["sky"], sl), b_, dtype, device, 2)
-        if day is not None:  # per azimuth node: the scattered sky along the mirror azimuth
+        if day is None:
+            sky = _sky_per_image(select_sky(p["sky"], sl), b_, dtype, device, 2)
+        else:  # per azimuth node: the scattered sky along the mirror azimuth
             sky = _sky_with_day(select_sky(p["sky"], sl), day, p, sl, ph_nodes[:, None, :])
         t_s, t_rho, _ = _reflection_terms(vz, va, slopes, (p["n"][sl, None, None], p["k"][sl, None, None]), sky,
                                           scene.shadowing, q, None, scene.sky_masking)
@@ -1326,14 +1327,15 @@ def _render_table(
         k_sky = (2.0 / (N - 1)) / ds
         b_sky = 2.0 * Mz / (N - 1) - 1.0 - k_sky * s0
         k_sea, b_sea, k_sky, b_sky = (v.to(dtype)[:, None, None] for v in (k_sea, b_sea, k_sky, b_sky))
+        # the azimuth coordinate's offset: o = (ray azimuth + offset) mod π (folded: ψ = |o − π/2|)
+        offset = None if iso else ((math.pi / 2 - wd).to(dtype) if fold else
+                                   (math.pi / 2 - rg.centre - wd.double()).to(dtype))
         if geometry is not None:
             cos, sea = geometry.cos_view_zenith[sl], geometry.is_sea[sl]
             seaf = sea.to(dtype)
             dx, dy = geometry._dx[sl], geometry._dy[sl]
             zeta = _asinh((cos * inv_eps[sl, None, None]).clamp_min(0.0))
         else:  # ζ straight from the ray's vertical component dz: cos θ̂ / ε = (k_r/ε) √((dz + s_h)(dz − s_h))
-            offset = None if iso else ((math.pi / 2 - wd).to(dtype) if fold else
-                                       (math.pi / 2 - rg.centre - wd.double()).to(dtype))
             cos, dx, dy = cg.ray_components(sl, need_xy=not (iso or ratio) or sunny)
             if ratio:  # the table's azimuth coordinate from components along axes turned by the offset
                 c_t, s_t = cg.ray_components(sl, azimuth_offset=offset)
@@ -1362,8 +1364,6 @@ def _render_table(
             else:
                 k_az = (2.0 / ((b - a) * (1.0 + ep))).to(dtype)[:, None, None]
                 b_az = ((-2.0 * a / (b - a) - 1.0) / (1.0 + ep)).to(dtype)[:, None, None]
-                if geometry is not None:
-                    offset = (math.pi / 2 - wd).to(dtype) if fold else (math.pi / 2 - rg.centre - wd.double()).to(dtype)
                 az = _azimuth_coordinate(dx, dy, offset, fold)
             gx = torch.addcmul(b_az, az, k_az)
         # bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges
@@ -1379,15 +1379,14 @@ def _render_table(
         if day is not None and has_sky:  # the scattered sky of the sky pixels, by zenith and azimuth
             vals = vals + (1.0 - seaf) * _day_sky_pixels(day, sl, cos, dx, dy)
         resolved = None
-        if textured and delta is not None:
+        if textured or sunny:  # cos θ̂ of the sea pixels, from q (these scenes need the cameras)
             cos_t = eps[sl, None, None].to(dtype) * torch.sqrt(q_)
-            o = _azimuth_coordinate(dx, dy, offset, fold)
-            texture, x_pix, cov_pix, *crest_var = tex.pixels(sl, p, wf, delta, cos_t, zeta, o, dx, dy, sea, lo,
+        if textured and delta is not None:  # (textured: always the angle coordinate, az)
+            texture, x_pix, cov_pix, *crest_var = tex.pixels(sl, p, wf, delta, cos_t, zeta, az, dx, dy, sea, lo,
                                                              span_z, a, b, altitude, earth_radius_m, eps[sl], crest=crest)
             vals = vals + texture
             resolved = (x_pix, cov_pix)
         if sunny:
-            cos_t = eps[sl, None, None].to(dtype) * torch.sqrt(q_)
             glint = _glint_pixels(scene, p, sl, cos_t, dx, dy, sea, altitude, earth_radius_m, resolved)
             if p["foam"] is not None and not crest:
                 glint = glint * (1.0 - p["foam"][sl].to(dtype))[:, None, None]

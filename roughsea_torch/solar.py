@@ -189,17 +189,24 @@ class SolarIrradiance:
         e = torch.exp(y)
         if not horizon:
             return torch.where(z > half_pi, torch.zeros_like(e), e)
-        # visible fraction of a uniform disk whose centre is c radii below the horizon:
-        # (acos c − c √(1 − c²)) / π, c clamped inside (−1, 1) so that acos keeps a finite slope
-        eps = 1e-6 if z.dtype == torch.float64 else 1e-3
-        c = ((z - half_pi) / SUN_RADIUS).clamp(-1.0 + eps, 1.0 - eps)
-        frac = (torch.acos(c) - c * torch.sqrt(1.0 - c * c)) / math.pi
-        frac = torch.where(z <= half_pi - SUN_RADIUS, torch.ones_like(frac), frac)
-        return torch.where(z >= half_pi + SUN_RADIUS, torch.zeros_like(e), e * frac)
+        return e * disk_fraction(z)
 
     def __repr__(self) -> str:
         return (f"SolarIrradiance({self.atmosphere!r}, band=({self.band.lo:.4g}, {self.band.hi:.4g}) m, "
                 f"toa={self.toa:.4g} W m-2)")
+
+
+def disk_fraction(z: torch.Tensor) -> torch.Tensor:
+    """Visible fraction of a uniform solar disk whose centre is at apparent zenith z [rad]: 1 up to
+    90° − α, ½ at 90°, 0 from 90° + α (α = ``SUN_RADIUS``): (acos c − c √(1 − c²)) / π with the
+    centre c radii below the horizon, c clamped inside (−1, 1) so that acos keeps a finite slope.
+    Dims the direct beam here and the scattered sky in :mod:`roughsea_torch.daysky`."""
+    half_pi = math.pi / 2
+    eps = 1e-6 if z.dtype == torch.float64 else 1e-3
+    c = ((z - half_pi) / SUN_RADIUS).clamp(-1.0 + eps, 1.0 - eps)
+    frac = (torch.acos(c) - c * torch.sqrt(1.0 - c * c)) / math.pi
+    frac = torch.where(z <= half_pi - SUN_RADIUS, torch.ones_like(frac), frac)
+    return torch.where(z >= half_pi + SUN_RADIUS, torch.zeros_like(frac), frac)
 
 
 def load_solar_irradiance(
