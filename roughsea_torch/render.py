@@ -1201,6 +1201,9 @@ def _render_table(
     # the table's azimuth coordinate: from cameras, without texture (whose own table reads the angle),
     # the cheap u of _azimuth_ratio, the fine columns uniform in u; else the angle
     ratio = not (iso or textured) and geometry is None
+    if sunny and cg is None:
+        raise ValueError("geometry=: a scene with a sun needs the cameras (its glint and disk are per pixel, the "
+                         "disk sized by the pixel's field of view); call render(cameras, scene) without geometry=")
     if textured:
         if cg is None:
             raise ValueError("geometry=: a textured scene (seed=...) needs the cameras (it places waves in the world); "

@@ -262,3 +262,14 @@ def test_the_suns_disk_in_the_sky_carries_its_irradiance():
     assert abs(total / 12.0 - 1) < 0.01
     direct = rs.render(cams, scene, method="direct")
     assert float(((img - direct) / direct).abs().max()) < 1e-5
+
+
+def test_sunny_scene_with_precomputed_geometry_is_a_clear_error():
+    """The glint and the sun's disk are per pixel and need the cameras (the disk's size is the
+    pixel's field of view): render(..., geometry=) of a sunny scene raises a ValueError that says
+    so (it failed with an UnboundLocalError inside the renderer), and the cameras' render works."""
+    cams = rs.make_camera(8, 10, hfov_deg=20.0, altitude_m=20.0, pitch_deg=-4.0, dtype=torch.float64)
+    scene = rs.SeaScene(wind_speed=5.0, sea_temperature=290.0, sun=rs.Sun(math.radians(70.0), 0.0, 10.0))
+    with pytest.raises(ValueError, match="geometry="):
+        rs.render(cams, scene, geometry=rs.view_geometry(cams))
+    assert bool(torch.isfinite(rs.render(cams, scene)).all())
