@@ -35,6 +35,7 @@ from .radiometry import (
 from .sky import ConstantSky, TabulatedSky
 from .geometry import EARTH_RADIUS_M, ViewGeometry, make_camera, view_geometry
 from .render import SeaRenderer, SeaScene, TableSize, render
+from ._pixels import release_workspace
 from .sensitivity import pixel_derivative
 from .slopes import SlopeStatistics, slope_pdf
 from .waves import WaveField, elfouhaily_spectrum
@@ -92,6 +93,7 @@ __all__ = [
     "planck_radiance",
     "projected_area",
     "reflection_terms",
+    "release_workspace",
     "render",
     "slope_pdf",
     "smith_lambda",

@@ -186,6 +186,14 @@ def view_geometry(
     return out
 
 
+def turned_axes(A: torch.Tensor, offset: torch.Tensor) -> torch.Tensor:
+    """World x and y axes turned by −``offset`` (b,) [rad], in camera axes (b, 2, 3), from ``A`` (b, 3, 3)
+    (world x, y, vertical in camera axes): x' = cos o x − sin o y, y' = sin o x + cos o y, so that a
+    ray's components along them have atan2 = the ray's azimuth + offset."""
+    co, so = torch.cos(offset)[:, None], torch.sin(offset)[:, None]
+    return torch.stack([co * A[:, 0] - so * A[:, 1], so * A[:, 0] + co * A[:, 1]], 1)
+
+
 def _component(a: torch.Tensor, x: torch.Tensor, y: torch.Tensor, inv: torch.Tensor | None) -> torch.Tensor:
     """a · (x, y, 1) / |(x, y, 1)|: a world axis ``a`` (b, 3, ...) in camera axes against the unit ray
     of normalized image coordinates (x, y) (``inv`` = 1/|(x, y, 1)|), broadcast over (x, y)."""
@@ -249,17 +257,11 @@ class CameraGeometry:
         H, W = self.H, self.W
         K = self.cameras.camera_matrix[sl].to(self.dtype)
         A = self.axes_cam[sl]  # (b, 3 components, 3 camera axes)
-        if azimuth_offset is not None:  # x' = cos o x − sin o y, y' = sin o x + cos o y
-            co, so = torch.cos(azimuth_offset)[:, None], torch.sin(azimuth_offset)[:, None]
-            A_t = torch.stack([co * A[:, 0] - so * A[:, 1], so * A[:, 0] + co * A[:, 1]], 1)
-        if bool((K[:, 0, 1] == 0).all()):
-            b_ = K.shape[0]
-            u = torch.arange(W, dtype=self.dtype, device=self.device)
-            v = torch.arange(H, dtype=self.dtype, device=self.device)
-            row = torch.stack([u, torch.zeros_like(u)], -1).expand(b_, W, 2)
-            col = torch.stack([torch.zeros_like(v), v], -1).expand(b_, H, 2)
-            x = normalize_points_with_intrinsics(row, K)[..., 0][:, None, :]  # (b, 1, W)
-            y = normalize_points_with_intrinsics(col, K)[..., 1][:, :, None]  # (b, H, 1)
+        if azimuth_offset is not None:
+            A_t = turned_axes(A, azimuth_offset)
+        xy = self.separable_xy(sl)
+        if xy is not None:
+            x, y = xy
             # 1/|(x, y, 1)|: one full-size add (not for the unnormalized turned components)
             inv = None if azimuth_offset is not None else torch.rsqrt(x * x + (y * y + 1.0))
 
@@ -277,6 +279,28 @@ class CameraGeometry:
         if azimuth_offset is not None:
             return comp(0), comp(1)
         return (comp(2), comp(0), comp(1)) if need_xy else (comp(2), None, None)
+
+    def separable_xy(self, sl: slice) -> tuple[torch.Tensor, torch.Tensor] | None:
+        """Normalized image coordinates of the pixel centres of the cameras ``sl``, x (b, 1, W) by
+        column and y (b, H, 1) by row, from kornia's unprojection; None for a camera with skew
+        (where x depends on the row too)."""
+        K = self.cameras.camera_matrix[sl].to(self.dtype)
+        if not bool((K[:, 0, 1] == 0).all()):
+            return None
+        b_ = K.shape[0]
+        u = torch.arange(self.W, dtype=self.dtype, device=self.device)
+        v = torch.arange(self.H, dtype=self.dtype, device=self.device)
+        row = torch.stack([u, torch.zeros_like(u)], -1).expand(b_, self.W, 2)
+        col = torch.stack([torch.zeros_like(v), v], -1).expand(b_, self.H, 2)
+        x = normalize_points_with_intrinsics(row, K)[..., 0][:, None, :]  # (b, 1, W)
+        y = normalize_points_with_intrinsics(col, K)[..., 1][:, :, None]  # (b, H, 1)
+        return x, y
+
+    @property
+    def requires_grad(self) -> bool:
+        """Whether the per-pixel rays carry gradients (a pose or intrinsics that require grad)."""
+        return torch.is_grad_enabled() and any(
+            t.requires_grad for t in (self.axes_cam, self.cameras.intrinsics, self.alt))
 
     def pixels(self, sl: slice, need_xy: bool = True) -> dict[str, torch.Tensor]:
         """cos θ̂ (sea) / cos of the ray's zenith (sky), the sea mask, and the unit ray's local-vertical

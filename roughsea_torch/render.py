@@ -36,6 +36,7 @@ import torch.nn.functional as F
 from kornia.geometry.camera import PinholeCamera
 
 from ._parallel import map_chunks
+from ._pixels import table_grid
 from ._validation import check_finite_range, per_batch
 from .expectation import Quadrature, _reflection_terms, apparent_radiance
 from .clutter import TextureTable
@@ -1333,6 +1334,23 @@ def _render_table(
         # the azimuth coordinate's offset: o = (ray azimuth + offset) mod π (folded: ψ = |o − π/2|)
         offset = None if iso else ((math.pi / 2 - wd).to(dtype) if fold else
                                    (math.pi / 2 - rg.centre - wd.double()).to(dtype))
+        # the main path (cameras, no texture or sun, no gradient through the rays): in place, in a
+        # reused workspace (roughsea_torch._pixels)
+        xy = (None if geometry is not None or textured or sunny or (not iso and not ratio) or cg.requires_grad
+              else cg.separable_xy(sl))
+        if xy is not None:
+            c1 = (inv_eps[sl] if cg.flat else cg.k_r[sl].to(dtype) * inv_eps[sl])[:, None, None]
+            sh = cg.s_h[sl, None, None] if not cg.flat else torch.zeros_like(c1)
+            az = None if iso else dict(offset=offset, fold=fold,
+                                       k=(2.0 / ((u_b - u_a) * (1.0 + ep))).to(dtype)[:, None, None],
+                                       b=((-2.0 * u_a / (u_b - u_a) - 1.0) / (1.0 + ep)).to(dtype)[:, None, None])
+            grid, seaf = table_grid(cg, sl, xy, c1, sh, (k_sea, b_sea), (k_sky, b_sky) if has_sky else None, az,
+                                    fresh_grid=torch.is_grad_enabled() and fine.requires_grad)
+            vals = F.grid_sample(fine, grid, mode="bilinear", padding_mode="border", align_corners=True)[:, 0]
+            if vals.requires_grad or len(chunks) == 1:
+                return vals
+            out[sl] = vals
+            return None
         if geometry is not None:
             cos, sea = geometry.cos_view_zenith[sl], geometry.is_sea[sl]
             seaf = sea.to(dtype)

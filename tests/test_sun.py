@@ -191,7 +191,8 @@ def test_render_with_sun_matches_per_pixel_evaluation_and_leaves_out_what_sees_n
     """MWIR, sun ahead of the camera 20° and 10° above the horizon: the table render equals the
     per-pixel evaluation (the glint itself is per pixel) to 1e-6 and the glint is strong (the
     brightest pixel well above the sea's own radiance); a sun behind the camera on these seas
-    changes no pixel at all (no glint work is done)."""
+    changes no pixel beyond rounding (the sunless render takes the in-place pixel path, the sunny one
+    the general path: 3.4e-16 relative measured)."""
     cams = rs.make_camera(32, 40, hfov_deg=20.0, altitude_m=20.0, pitch_deg=-5.0, batch_size=2, dtype=torch.float64)
     sun = rs.Sun(torch.tensor([math.radians(70.0), math.radians(80.0)]), 0.0, 12.0)  # world azimuth 0: ahead
     table = rs.render(cams, _sunny_scene(sun))
@@ -200,7 +201,7 @@ def test_render_with_sun_matches_per_pixel_evaluation_and_leaves_out_what_sees_n
     assert float(((table - direct) / direct).abs().max()) < 1e-6
     assert float((table / mean).max()) > 5.0
     behind = rs.render(cams, _sunny_scene(rs.Sun(math.radians(40.0), math.pi, 12.0)))
-    assert torch.equal(behind, mean)
+    assert float(((behind - mean) / mean).abs().max()) < 1e-13
     kelvin = rs.render(cams, _sunny_scene(sun), output="brightness_temperature")
     assert float(kelvin.max()) > 320.0
 
