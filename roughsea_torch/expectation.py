@@ -252,7 +252,7 @@ def _emissivity_numerator(
         t = g.ct[:, None] + g.st[:, None] * u
         v = (g.mv[:, None] + g.kappa[:, None] * du)[..., None] + g.tau[:, None, None] * zh  # (m, no, nh)
         cos_o = t.abs()[..., None] * torch.rsqrt(1.0 + u[..., None] ** 2 + v * v)
-        _, _, es, ep = _fresnel_terms(cos_o.clamp_max(1.0), n_, k_)
+        es, ep = _fresnel_terms(cos_o.clamp_max(1.0), n_, k_, emission=True)
         e = (0.5 * (es + ep) * wh).sum(-1)
         total = total + (W * t * e).sum(-1)
     return total
@@ -342,7 +342,7 @@ def _sky_numerator(
     cos_o = (t[..., None] * torch.sqrt(inv)).clamp(0.0, 1.0)
     hh = h[..., None]
     cos_r = (ct[:, None, None] * (hh - v) * (hh + v) * inv).clamp(0.0, 1.0)
-    rs, rp, _, _ = _fresnel_terms(cos_o, n[:, None, None], k[:, None, None])
+    rs, rp = _fresnel_terms(cos_o, n[:, None, None], k[:, None, None])
     m = cos_r.shape[0]
     radiance = sky(cos_r.reshape(m, -1)).reshape(cos_r.shape)
     w_rho = Wz * 0.5 * (rs + rp)

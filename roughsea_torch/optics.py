@@ -58,10 +58,9 @@ def split_refractive_index(
     return as_tensor(n, dtype, device), as_tensor(k, dtype, device)
 
 
-def _fresnel_terms(
-    c: torch.Tensor, n: torch.Tensor, k: torch.Tensor
-) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-    """Numerators and denominators of |r_s|² and |r_p|², and of 1 − |r_s|², 1 − |r_p|².
+def _fresnel_terms(c: torch.Tensor, n: torch.Tensor, k: torch.Tensor, emission: bool = False
+                   ) -> tuple[torch.Tensor, torch.Tensor]:
+    """(|r_s|², |r_p|²), or with ``emission`` (1 − |r_s|², 1 − |r_p|²), each from its own form.
 
     c = |cos i| ∈ [0, 1]. With m² = M + i N (M = n² − k², N = 2 n k) and
     √(m² − sin² i) = p + i q (principal root, p ≥ 0, q ≥ 0):
@@ -70,27 +69,29 @@ def _fresnel_terms(
         |r_p|² = ((M c − p)² + (N c − q)²) / ((M c + p)² + (N c + q)²),
         1 − |r_p|² = 4 c (M p + N q) / ((M c + p)² + (N c + q)²)
 
-    The second forms give the emissivity 1 − ρ without cancellation near normal incidence.
+    The second forms give the emissivity 1 − ρ without cancellation near normal incidence. Only the
+    pair asked for is formed (the model's integrands need one or the other).
     """
     M = n * n - k * k
     N = 2.0 * n * k
     A = M - (1.0 - c * c)  # Re(m² − sin² i)
     mod = torch.sqrt(A * A + N * N)
-    # Stable complex square root: take the large component from a sum, the other from N / (2·it).
-    pos = A >= 0
-    big = torch.sqrt(0.5 * (mod + A.abs()))
-    big_safe = torch.where(big > 0, big, torch.ones_like(big))
-    small = torch.where(big > 0, N / (2.0 * big_safe), torch.zeros_like(big))
-    p = torch.where(pos, big, small)
-    q = torch.where(pos, small, big)
+    if bool((M > 1.0).all()):  # A ≥ M − 1 > 0 at every angle (water): p is the large component
+        p = torch.sqrt(0.5 * (mod + A))
+        q = N / (2.0 * p)
+    else:  # stable complex square root: the large component from a sum, the other from N / (2·it)
+        pos = A >= 0
+        big = torch.sqrt(0.5 * (mod + A.abs()))
+        big_safe = torch.where(big > 0, big, torch.ones_like(big))
+        small = torch.where(big > 0, N / (2.0 * big_safe), torch.zeros_like(big))
+        p = torch.where(pos, big, small)
+        q = torch.where(pos, small, big)
     ds = (c + p) ** 2 + q * q
     Mc, Nc = M * c, N * c
     dp = (Mc + p) ** 2 + (Nc + q) ** 2
-    rs = ((c - p) ** 2 + q * q) / ds
-    rp = ((Mc - p) ** 2 + (Nc - q) ** 2) / dp
-    es = 4.0 * c * p / ds
-    ep = 4.0 * c * (M * p + N * q) / dp
-    return rs, rp, es, ep
+    if emission:
+        return 4.0 * c * p / ds, 4.0 * c * (M * p + N * q) / dp
+    return ((c - p) ** 2 + q * q) / ds, ((Mc - p) ** 2 + (Nc - q) ** 2) / dp
 
 
 def fresnel_reflectance(
@@ -117,7 +118,7 @@ def fresnel_reflectance(
     dtype, device = resolve_dtype_device(cos_incidence=cos_incidence, refractive_index=refractive_index)
     c = as_tensor(cos_incidence, dtype, device).abs()
     n, k = split_refractive_index(refractive_index, dtype, device)
-    rs, rp, _, _ = _fresnel_terms(c, n, k)
+    rs, rp = _fresnel_terms(c, n, k)
     if polarization == "s":
         return rs
     if polarization == "p":
@@ -131,7 +132,7 @@ def fresnel_emissivity(cos_incidence: Any, refractive_index: Any) -> torch.Tenso
     dtype, device = resolve_dtype_device(cos_incidence=cos_incidence, refractive_index=refractive_index)
     c = as_tensor(cos_incidence, dtype, device).abs()
     n, k = split_refractive_index(refractive_index, dtype, device)
-    _, _, es, ep = _fresnel_terms(c, n, k)
+    es, ep = _fresnel_terms(c, n, k, emission=True)
     return 0.5 * (es + ep)
 
 
@@ -222,7 +223,7 @@ def band_refractive_index(
     h = 1e-6
     for _ in range(12):
         def res(nn, kk):
-            rs, rp, _, _ = _fresnel_terms(c, nn[..., None], kk[..., None])
+            rs, rp = _fresnel_terms(c, nn[..., None], kk[..., None])
             return 0.5 * (rs + rp) - target
 
         r0 = res(n, k)
@@ -237,7 +238,7 @@ def band_refractive_index(
     # keep whichever of the fit and the plain average matches ρ̄ better at its worst angle (in the
     # MWIR the least-squares optimum wants k < 0, and the bounded fit loses to the average)
     def worst(nn, kk):
-        rs, rp, _, _ = _fresnel_terms(c, nn[..., None], kk[..., None])
+        rs, rp = _fresnel_terms(c, nn[..., None], kk[..., None])
         return (0.5 * (rs + rp) - target).abs().amax(-1)
 
     use_fit = worst(n, k) <= worst(avg.real, avg.imag)
@@ -266,5 +267,5 @@ def band_reflectance(
     lam, w = band_weights(b, temperature, dtype, device)
     m = water_refractive_index(lam, source)
     c = as_tensor(cos_incidence, dtype, device).abs().unsqueeze(-1)
-    rs, rp, _, _ = _fresnel_terms(c, m.real.to(dtype), m.imag.to(dtype))
+    rs, rp = _fresnel_terms(c, m.real.to(dtype), m.imag.to(dtype))
     return (0.5 * (rs + rp) * w).sum(-1)

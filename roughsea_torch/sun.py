@@ -261,7 +261,7 @@ def glint_radiance(view_zenith: Any, view_azimuth: Any, slopes: Any, refractive_
     s_y = my + l21 * zx + l22 * zy
     t_g = ct + st * (s_x * torch.cos(va) + s_y * torch.sin(va))
     cos_omega = (t_g * torch.rsqrt(1.0 + s_x * s_x + s_y * s_y)).clamp(0.0, 1.0)
-    rs_, rp_, _, _ = _fresnel_terms(cos_omega, n, k)
+    rs_, rp_ = _fresnel_terms(cos_omega, n, k)
     rho = 0.5 * (rs_ + rp_)
     g = _geometry(vz, va, vx, vy, cxy, mx, my)
     D = _denominator(g, shadowing)
