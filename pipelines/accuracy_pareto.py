@@ -100,12 +100,14 @@ WIDTHS = {F32: [5.0, 7.0], F64: [6.5, 8.5]}  # the default orders with another w
 REF_TOLS = [1e-3, 1e-5, 1e-7, 1e-10]
 BF_N = [16, 32, 64, 128, 256, 512]
 MC_N = [100, 1_000, 10_000, 100_000]
-TABLES = [(9, 5, 512, 32), (13, 5, 1024, 64), (17, 7, 2048, 64), (21, 7, 4096, 64), (25, 9, 4096, 128), (33, 13, 8192, 256), (49, 17, 8192, 512),
-          (65, 33, 16384, 512)]
+_D = rs.TableSize()
+DEFAULT_TABLE = (_D.zenith, _D.azimuth, _D.fine_zenith, _D.fine_azimuth)  # the ladder always holds the default
+TABLES = sorted({(9, 5, 512, 32), (13, 5, 1024, 64), (17, 7, 2048, 64), (21, 7, 4096, 64), (25, 9, 4096, 128), (33, 13, 8192, 256),
+                 (49, 17, 8192, 512), (65, 33, 16384, 512), DEFAULT_TABLE})
 RENDER_REF_Q = Quadrature(outer=40, inner=40, hermite=16, width=8.5)
 
 QUICK = dict(LADDER=[(8, 5, 5.0), (20, 8, 6.0), (28, 12, 7.5)], WIDTHS={F32: [], F64: []}, REF_TOLS=[1e-4], BF_N=[16, 64],
-             MC_N=[100, 10_000], TABLES=[(13, 5, 1024, 64), (21, 7, 4096, 64)])
+             MC_N=[100, 10_000], TABLES=sorted({(13, 5, 1024, 64), DEFAULT_TABLE}))
 
 
 def q_of(n: int, h: int, w: float) -> Quadrature:
