@@ -991,24 +991,31 @@ def _sky_with_day(sky: TabulatedSky, day: tuple, p: dict[str, Any], idx: Any, vi
     return sky.with_radiance(thermal + scat)
 
 
-def _day_sky_pixels(day: tuple, sl: Any, cos: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor) -> torch.Tensor:
+def _day_sky_pixels(day: tuple, sl: Any, cos: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor,
+                    img: torch.Tensor | None = None) -> torch.Tensor:
     """The scattered sky along the rays of sky pixels (cos of the ray's zenith, world x/y components;
-    rays below the horizontal see it at the horizontal), (b, H, W)."""
+    rays below the horizontal see it at the horizontal), (b, H, W); or, with ``img`` (each pixel's image
+    within ``sl``), at gathered pixels, all 1-D."""
     ds, z_sun, a_sun = day
-    extra = (slice(None), None, None)
-    rel = torch.atan2(dy, dx) - a_sun[sl].to(cos.dtype)[extra]
-    return ds(cos.clamp(0.0, 1.0), rel, z_sun[sl].to(cos.dtype)[extra].expand_as(cos))
+    a, z = a_sun[sl].to(cos.dtype), z_sun[sl].to(cos.dtype)
+    if img is None:
+        a, z = a[:, None, None], z[:, None, None].expand_as(cos)
+    else:
+        a, z = a.index_select(0, img), z.index_select(0, img)
+    return ds(cos.clamp(0.0, 1.0), torch.atan2(dy, dx) - a, z)
 
 
 def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Tensor, dx: torch.Tensor,
-                  dy: torch.Tensor, sea: torch.Tensor, altitude: torch.Tensor, earth_radius_m: float,
+                  dy: torch.Tensor, sea: torch.Tensor, tau_rows: tuple[torch.Tensor, torch.Tensor] | None,
                   resolved: tuple | None = None) -> torch.Tensor:
     """τ · R_glint at the sea pixels of images ``sl`` (b, H, W), 0 elsewhere. Only pixels whose specular
     slope lies within 6 standard deviations (whitened) of the slope law, plus the disk's own extent,
     are evaluated: the rest of the image carries less than exp(−18) = 1.5e-8 of the glint's peak. On a
     textured sea (``resolved`` = each pixel's flat-point quantile x and resolved covariance) the glint
     is that of the pixel's own unresolved Gaussian about its visible resolved slope, as the sky's
-    reflection is (:mod:`roughsea_torch.clutter`), so its ensemble mean is the expectation's glint."""
+    reflection is (:mod:`roughsea_torch.clutter`), so its ensemble mean is the expectation's glint.
+    ``tau_rows`` = (τ at the fine table's sea rows (b, M_z), each pixel's fractional row (b, H, W))
+    with a path, else None."""
     from .sun import glint_radiance
 
     b_, H, W = cos_t.shape
@@ -1044,29 +1051,35 @@ def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Te
     per = lambda t: t[sl].index_select(0, img)  # noqa: E731  (a (B,) scene field at the kept pixels)
     c_k, dx_k, dy_k = at(cos_t), at(dx), at(dy)
     phi = torch.atan2(-dy_k, -dx_k) - per(p["wind_direction"])
-    slopes = SlopeStatistics.from_variances(per(p["vx"]), per(p["vy"]), per(p["cxy"]))
-    from .sun import Sun, sun_masking_factor
+    from .sun import _glint, sun_masking_factor
 
-    s_k = Sun(*(v.index_select(0, img) for v in (sun.zenith, sun.azimuth, sun.irradiance, sun.radius)))
-    masking = scene.sun_masking
+    # the sun's masking is Smith's G1 of the scene's total slope law (resolved waves mask the sun too):
+    # one value per image
+    g1 = None
+    if scene.sun_masking:
+        g1 = sun_masking_factor(SlopeStatistics.from_variances(p["vx"][sl], p["vy"][sl], p["cxy"][sl]), sun, dtype,
+                                device).index_select(0, img)
+    vx, vy, cxy, mx, my = per(p["vx"]), per(p["vy"]), per(p["cxy"]), None, None
     if resolved is not None:
-        # the sun is masked by all the waves: the G1 of the total law (see sun_masking_factor)
-        g1 = sun_masking_factor(slopes, s_k, dtype, device) if masking else None
-        masking = False
         from .clutter import along_view, two_scale_statistics
 
         inv = torch.rsqrt((dx_k ** 2 + dy_k ** 2).clamp_min(1e-30))
         var_a, kap = along_view(tuple(at(c) for c in resolved[1]), -dx_k * inv, -dy_k * inv)
-        slopes = _squeeze_last(two_scale_statistics(slopes.var_upwind, slopes.var_crosswind, slopes.cov, phi, c_k,
-                                                    at(resolved[0])[:, None], var_a, kap))
-    g = glint_radiance(torch.acos(c_k.clamp(-1.0, 1.0)), phi, slopes, (per(p["n"]), per(p["k"])), s_k,
-                       scene.shadowing, masking)
-    if resolved is not None and g1 is not None:
+        shifted = _squeeze_last(two_scale_statistics(vx, vy, cxy, phi, c_k, at(resolved[0])[:, None], var_a, kap))
+        (vx, vy, cxy), (mx, my) = shifted.tensors(dtype, device), shifted.mean_tensors(dtype, device)
+    g = _glint(torch.acos(c_k.clamp(-1.0, 1.0)), phi, vx, vy, cxy, mx, my, per(p["n"]), per(p["k"]),
+               *(v.index_select(0, img) for v in (sun.zenith, sun.azimuth, sun.irradiance, sun.radius)), scene.shadowing)
+    if g1 is not None:
         g = g * g1
-    if scene.path is not None:
-        h = per(altitude.to(dtype))
-        tau, _ = scene.path(h, _slant_range(c_k, h, earth_radius_m), clamp=True)
-        g = g * tau.to(dtype)
+    if tau_rows is not None:  # the path's transmittance: quadratic through the table's 3 nearest rows
+        tau_r, row = tau_rows
+        m = tau_r.shape[1]
+        r = at(row).clamp(0.0, m - 1.0)
+        i = r.detach().round().clamp(1, m - 2).long()
+        t = r - i.to(r.dtype)
+        flat_r = img * m + i
+        tm, t0, tp = (tau_r.reshape(-1).index_select(0, flat_r + d) for d in (-1, 0, 1))
+        g = g * (t0 + t * (0.5 * (tp - tm) + t * (0.5 * (tp + tm) - t0)))
     return out.reshape(-1).index_put((flat,), g).reshape(out.shape)
 
 
@@ -1397,8 +1410,11 @@ def _render_table(
             vals, foam_vals = vals[:, 0], vals[:, 1]
         else:
             vals = vals[:, 0]
-        if day is not None and has_sky:  # the scattered sky of the sky pixels, by zenith and azimuth
-            vals = vals + (1.0 - seaf) * _day_sky_pixels(day, sl, cos, dx, dy)
+        if day is not None and has_sky:  # the scattered sky of the sky pixels, by zenith and azimuth, at them alone
+            flat = (seaf.reshape(-1) == 0).nonzero().squeeze(1)
+            at = lambda t: t.reshape(-1).index_select(0, flat)  # noqa: E731
+            v = _day_sky_pixels(day, sl, at(cos), at(dx), at(dy), torch.div(flat, H * W, rounding_mode="floor"))
+            vals = vals.reshape(-1).index_add(0, flat, v).reshape(vals.shape)
         resolved = None
         if textured or sunny:  # cos θ̂ of the sea pixels, from q (these scenes need the cameras)
             cos_t = eps[sl, None, None].to(dtype) * torch.sqrt(q_)
@@ -1408,7 +1424,11 @@ def _render_table(
             vals = vals + texture
             resolved = (x_pix, cov_pix)
         if sunny:
-            glint = _glint_pixels(scene, p, sl, cos_t, dx, dy, sea, altitude, earth_radius_m, resolved)
+            rows = None
+            if scene.path is not None:  # each pixel's fractional sea row of the fine table
+                rows = (tau.to(dtype), (zeta - (lo - ez * span_z / 2).to(dtype)[:, None, None])
+                        * ((Mz - 1) / (span_z * (1.0 + ez))).to(dtype)[:, None, None])
+            glint = _glint_pixels(scene, p, sl, cos_t, dx, dy, sea, rows, resolved)
             if p["foam"] is not None and not crest:
                 glint = glint * (1.0 - p["foam"][sl].to(dtype))[:, None, None]
             vals = vals + glint

@@ -203,8 +203,8 @@ def glint_radiance(view_zenith: Any, view_azimuth: Any, slopes: Any, refractive_
     Returns:
         R_glint, the broadcast shape, the inputs' dtype and device; 0 for a sun below the horizon.
     """
-    from .expectation import _denominator, _geometry, _prepare
-    from .optics import _fresnel_terms, split_refractive_index
+    from .expectation import _prepare
+    from .optics import split_refractive_index
 
     dtype, device, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes, refractive_index,
                                                           sun_zenith=sun.zenith, sun_azimuth=sun.azimuth,
@@ -212,6 +212,21 @@ def glint_radiance(view_zenith: Any, view_azimuth: Any, slopes: Any, refractive_
     n, k = split_refractive_index(refractive_index, dtype, device)
     tz, tp = as_tensor(sun.zenith, dtype, device), as_tensor(sun.azimuth, dtype, device)
     e_sun, alpha = as_tensor(sun.irradiance, dtype, device), as_tensor(sun.radius, dtype, device)
+    out = _glint(vz, va, vx, vy, cxy, mx, my, n, k, tz, tp, e_sun, alpha, shadowing)
+    if sun_masking:
+        out = out * sun_masking_factor(slopes, sun, dtype, device)
+    return out
+
+
+def _glint(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor,
+           mx: torch.Tensor | None, my: torch.Tensor | None, n: torch.Tensor, k: torch.Tensor, tz: torch.Tensor,
+           tp: torch.Tensor, e_sun: torch.Tensor, alpha: torch.Tensor, shadowing: bool) -> torch.Tensor:
+    """:func:`glint_radiance` without the sun's masking, on checked tensors (the renderer calls it on
+    its own pixels, whose values need no second check)."""
+    from .expectation import _denominator, _geometry
+    from .optics import _fresnel_terms
+
+    dtype, device = vz.dtype, vz.device
     zero = torch.zeros((), dtype=dtype, device=device)
     if mx is None:
         mx = my = zero
@@ -267,8 +282,6 @@ def glint_radiance(view_zenith: Any, view_azimuth: Any, slopes: Any, refractive_
     D = _denominator(g, shadowing)
     l_sun = e_sun / (4.0 * math.pi * torch.sin(0.5 * alpha) ** 2)  # Ω_sun = 2π(1 − cos α), without cancellation
     out = rho * t_g * l_sun * prob / D
-    if sun_masking:
-        out = out * sun_masking_factor(slopes, sun, dtype, device)
     return torch.where(above, out, torch.zeros_like(out))
 
 
