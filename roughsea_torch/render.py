@@ -241,6 +241,7 @@ class SeaScene:
                 raise ValueError(f"aerosol must be None or one of {list(AEROSOLS)}; got {aerosol!r}")
         self.aerosol = aerosol
         self._day_skies: dict[Any, Any] = {}
+        self._sun_cache: tuple | None = None
         self._sun = sun
         self.sun_zenith, self.sun_azimuth = sun_zenith, sun_azimuth
         self.sun_masking = sun_masking
@@ -267,13 +268,24 @@ class SeaScene:
         from .solar import load_solar_irradiance
         from .sun import Sun
 
-        e = load_solar_irradiance(self.atmosphere, (self.band.lo, self.band.hi), self.band.response,
-                                  aerosol=self.aerosol)
         z = self.sun_zenith
-        zt = z.double() if isinstance(z, torch.Tensor) else torch.tensor(float(z), dtype=torch.float64)
-        irr = e(zt)
-        if isinstance(z, torch.Tensor):
-            irr = irr.to(z.dtype)
+        # the renderer reads the sun many times a call: keep the last one, keyed by the fields' values
+        # (not when the zenith requires grad: its irradiance must join the caller's graph)
+        grad = isinstance(z, torch.Tensor) and z.requires_grad
+        key = None if grad else (self.atmosphere, self.band.lo, self.band.hi, id(self.band.response), self.aerosol,
+                                 (z.dtype, z.device, tuple(z.detach().flatten().tolist())) if isinstance(z, torch.Tensor)
+                                 else float(z))
+        cached = self._sun_cache
+        if key is not None and cached is not None and cached[0] == key:
+            irr = cached[1]
+        else:
+            e = load_solar_irradiance(self.atmosphere, (self.band.lo, self.band.hi), self.band.response,
+                                      aerosol=self.aerosol)
+            zt = z.double() if isinstance(z, torch.Tensor) else torch.tensor(float(z), dtype=torch.float64)
+            irr = e(zt)
+            if isinstance(z, torch.Tensor):
+                irr = irr.to(z.dtype)
+            self._sun_cache = None if key is None else (key, irr)
         return Sun(z, self.sun_azimuth, irr if isinstance(z, torch.Tensor) else float(irr))
 
     @sun.setter
@@ -458,6 +470,14 @@ class TableSize:
         zenith_narrow: nodes in ζ when some image's slope ellipse is narrow but not thin (minor/major
             rms slope < 0.5: Cox–Munk below ~0.3 m/s): views along the wind at W = 0.05 m/s,
             2.9e-5 with 17 nodes, 1.4e-5 with 21.
+        glint: Chebyshev–Lobatto nodes per axis (ζ, azimuth) of the glint's smooth factor L_sun G1 / D
+            (sunny scenes without texture whose table runs over the unfolded azimuth: every scene lit
+            through ``sun_zenith=`` with an aerosol, or with correlated slopes); each pixel applies
+            the sharp factor P ρ t itself (the sun's ellipse probability in slope space, Fresnel and
+            facet cosine at the facets that mirror the sun). An image whose table misses
+            ``glint_tolerance`` of the radiance at the fine cells' centres (checked against direct
+            evaluation) keeps the whole glint per pixel.
+        glint_tolerance: see ``glint``.
         fine_zenith, fine_azimuth: rows/columns of the fine table read by ``grid_sample``.
         fine_azimuth_thin: columns of the fine table when a slope ellipse is thin (64 columns leave
             views along the wind at W = 0 at 3e-5, 128 at 7e-6).
@@ -498,12 +518,14 @@ class TableSize:
     texture_quadrature: tuple = (20, 16)
     zenith_narrow: int = 21
     azimuth_day: int = 25
+    glint: int = 33
+    glint_tolerance: float = 1e-5
 
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):
             raise ValueError(f"TableSize.span must be 'pixels' or 'full'; got {self.span!r}")
         for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin", "zenith_narrow", "azimuth_day", "texture",
-                     "texture_zenith"):
+                     "texture_zenith", "glint"):
             if int(getattr(self, name)) < 2:
                 raise ValueError(f"TableSize.{name} must be >= 2")
         for name in ("fine_zenith", "fine_azimuth", "fine_sky", "fine_azimuth_thin", "fine_texture",
@@ -1005,25 +1027,33 @@ def _day_sky_pixels(day: tuple, sl: Any, cos: torch.Tensor, dx: torch.Tensor, dy
     return ds(cos.clamp(0.0, 1.0), torch.atan2(dy, dx) - a, z)
 
 
-def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Tensor, dx: torch.Tensor,
-                  dy: torch.Tensor, sea: torch.Tensor, tau_rows: tuple[torch.Tensor, torch.Tensor] | None,
-                  resolved: tuple | None = None) -> torch.Tensor:
-    """τ · R_glint at the sea pixels of images ``sl`` (b, H, W), 0 elsewhere. Only pixels whose specular
-    slope lies within 6 standard deviations (whitened) of the slope law, plus the disk's own extent,
-    are evaluated: the rest of the image carries less than exp(−18) = 1.5e-8 of the glint's peak. On a
-    textured sea (``resolved`` = each pixel's flat-point quantile x and resolved covariance) the glint
-    is that of the pixel's own unresolved Gaussian about its visible resolved slope, as the sky's
-    reflection is (:mod:`roughsea_torch.clutter`), so its ensemble mean is the expectation's glint.
-    ``tau_rows`` = (τ at the fine table's sea rows (b, M_z), each pixel's fractional row (b, H, W))
-    with a path, else None."""
-    from .sun import glint_radiance
+def _over_kept_pixels(keep: torch.Tensor, fn: Any, dtype: torch.dtype) -> torch.Tensor:
+    """``fn(m, at)`` over the kept pixels of each image m of ``keep`` (b, H, W) bool, into (b, H, W) (0
+    elsewhere); ``at(t)`` gathers a (b, H, W) field at the pixels of the call. Image by image (its sun
+    and slope law are scalars), in blocks of 2¹⁶ of its kept pixels, whose temporaries stay in cache and
+    in the allocator's heap (a fresh multi-megabyte temporary page-faults on every operation); every
+    operation is per pixel, so blocks change no value. Gathers by index_select on flat indices
+    (boolean-mask indexing costs ~4× more)."""
+    b_, H, W = keep.shape
+    out = torch.zeros(b_, H * W, dtype=dtype, device=keep.device)
+    for m in range(b_):
+        flat = keep[m].reshape(-1).nonzero().squeeze(1)
+        parts = []
+        for i in range(0, flat.numel(), 1 << 16):
+            fl = flat[i:i + (1 << 16)]
+            parts.append(fn(m, lambda t, fl=fl: t[m].reshape(-1).index_select(0, fl)))
+        if parts:
+            out = out.index_put((torch.full_like(flat, m), flat), parts[0] if len(parts) == 1 else torch.cat(parts))
+    return out.reshape(b_, H, W)
 
-    b_, H, W = cos_t.shape
-    dtype, device = cos_t.dtype, cos_t.device
-    B = p["vx"].shape[0]
-    idx_all = torch.arange(sl.start, sl.stop, device=device)
-    sun = _relative_sun(scene, p, B, dtype, device, idx_all)
-    with torch.no_grad():  # the mask only
+
+def _glint_mask(p: dict[str, Any], sl: slice, sun: Any, cos_t: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor,
+                sea: torch.Tensor) -> torch.Tensor:
+    """The sea pixels of images ``sl`` that can see glint (b, H, W) bool: those whose specular slope lies
+    within 6 standard deviations (whitened) of the slope law, plus the sun disk's own extent (the rest
+    carries less than exp(−18) = 1.5e-8 of the glint's peak), with the sun up. ``sun``: the images' sun
+    relative to upwind."""
+    with torch.no_grad():
         ct = cos_t.clamp(0.0, 1.0)
         st = torch.sqrt((1 - ct * ct).clamp_min(0.0))
         inv = torch.rsqrt((dx * dx + dy * dy).clamp_min(1e-30))
@@ -1040,47 +1070,166 @@ def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Te
         d2 = (b2 * sgx * sgx - 2 * c2 * sgx * sgy + a2 * sgy * sgy) / det
         lam_min = (0.5 * (a2 + b2 - torch.sqrt((a2 - b2) ** 2 + 4 * c2 * c2))).clamp_min(1e-24)
         reach = sun.radius[:, None, None] * 2.0 * (1 + sgx * sgx + sgy * sgy) / qz.clamp_min(1e-6) / torch.sqrt(lam_min)
-        keep = sea & (wz > 0) & (torch.sqrt(d2) - reach < 6.0)
-    out = torch.zeros_like(cos_t)
-    flat = keep.reshape(-1).nonzero().squeeze(1)  # the kept pixels' flat indices, found once
-    if flat.numel() == 0:
-        return out
-    # gathers by index_select on flat indices (boolean-mask or advanced indexing costs ~4x more)
-    at = lambda t: t.reshape(-1).index_select(0, flat)  # noqa: E731  (a (b, H, W) field at the kept pixels)
-    img = torch.div(flat, H * W, rounding_mode="floor")
-    per = lambda t: t[sl].index_select(0, img)  # noqa: E731  (a (B,) scene field at the kept pixels)
-    c_k, dx_k, dy_k = at(cos_t), at(dx), at(dy)
-    phi = torch.atan2(-dy_k, -dx_k) - per(p["wind_direction"])
+        return sea & (wz > 0) & (torch.sqrt(d2) - reach < 6.0)
+
+
+def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Tensor, dx: torch.Tensor,
+                  dy: torch.Tensor, sea: torch.Tensor, tau_rows: tuple[torch.Tensor, torch.Tensor] | None,
+                  resolved: tuple | None = None) -> torch.Tensor:
+    """τ · R_glint at the sea pixels of images ``sl`` (b, H, W), 0 elsewhere, evaluated at the pixels that
+    can see glint (:func:`_glint_mask`). On a
+    textured sea (``resolved`` = each pixel's flat-point quantile x and resolved covariance) the glint
+    is that of the pixel's own unresolved Gaussian about its visible resolved slope, as the sky's
+    reflection is (:mod:`roughsea_torch.clutter`), so its ensemble mean is the expectation's glint.
+    ``tau_rows`` = (τ at the fine table's sea rows (b, M_z), each pixel's fractional row (b, H, W))
+    with a path, else None."""
+    b_, H, W = cos_t.shape
+    dtype, device = cos_t.dtype, cos_t.device
+    B = p["vx"].shape[0]
+    sun = _relative_sun(scene, p, B, dtype, device, torch.arange(sl.start, sl.stop, device=device))
+    keep = _glint_mask(p, sl, sun, cos_t, dx, dy, sea)
     from .sun import _glint, sun_masking_factor
 
     # the sun's masking is Smith's G1 of the scene's total slope law (resolved waves mask the sun too):
     # one value per image
     g1 = None
     if scene.sun_masking:
-        g1 = sun_masking_factor(SlopeStatistics.from_variances(p["vx"][sl], p["vy"][sl], p["cxy"][sl]), sun, dtype,
-                                device).index_select(0, img)
-    vx, vy, cxy, mx, my = per(p["vx"]), per(p["vy"]), per(p["cxy"]), None, None
-    if resolved is not None:
-        from .clutter import along_view, two_scale_statistics
+        g1 = sun_masking_factor(SlopeStatistics.from_variances(p["vx"][sl], p["vy"][sl], p["cxy"][sl]), sun, dtype, device)
+    per_img = [p[k][sl].to(dtype) for k in ("wind_direction", "vx", "vy", "cxy", "n", "k")]
+    per_img += [sun.zenith, sun.azimuth, sun.irradiance, sun.radius]
 
-        inv = torch.rsqrt((dx_k ** 2 + dy_k ** 2).clamp_min(1e-30))
-        var_a, kap = along_view(tuple(at(c) for c in resolved[1]), -dx_k * inv, -dy_k * inv)
-        shifted = _squeeze_last(two_scale_statistics(vx, vy, cxy, phi, c_k, at(resolved[0])[:, None], var_a, kap))
-        (vx, vy, cxy), (mx, my) = shifted.tensors(dtype, device), shifted.mean_tensors(dtype, device)
-    g = _glint(torch.acos(c_k.clamp(-1.0, 1.0)), phi, vx, vy, cxy, mx, my, per(p["n"]), per(p["k"]),
-               *(v.index_select(0, img) for v in (sun.zenith, sun.azimuth, sun.irradiance, sun.radius)), scene.shadowing)
-    if g1 is not None:
-        g = g * g1
-    if tau_rows is not None:  # the path's transmittance: quadratic through the table's 3 nearest rows
-        tau_r, row = tau_rows
-        m = tau_r.shape[1]
-        r = at(row).clamp(0.0, m - 1.0)
-        i = r.detach().round().clamp(1, m - 2).long()
-        t = r - i.to(r.dtype)
-        flat_r = img * m + i
-        tm, t0, tp = (tau_r.reshape(-1).index_select(0, flat_r + d) for d in (-1, 0, 1))
-        g = g * (t0 + t * (0.5 * (tp - tm) + t * (0.5 * (tp + tm) - t0)))
-    return out.reshape(-1).index_put((flat,), g).reshape(out.shape)
+    def one(m: int, at: Any) -> torch.Tensor:
+        wd, vx, vy, cxy, n_, k_, tz, tp, e_sun, al = (v[m] for v in per_img)
+        c_k, dx_k, dy_k = at(cos_t), at(dx), at(dy)
+        phi = torch.atan2(-dy_k, -dx_k) - wd
+        mx = my = None
+        if resolved is not None:
+            from .clutter import along_view, two_scale_statistics
+
+            inv = torch.rsqrt((dx_k ** 2 + dy_k ** 2).clamp_min(1e-30))
+            var_a, kap = along_view(tuple(at(c) for c in resolved[1]), -dx_k * inv, -dy_k * inv)
+            shifted = _squeeze_last(two_scale_statistics(vx.expand_as(phi), vy.expand_as(phi), cxy.expand_as(phi), phi,
+                                                         c_k, at(resolved[0])[:, None], var_a, kap))
+            (vx, vy, cxy), (mx, my) = shifted.tensors(dtype, device), shifted.mean_tensors(dtype, device)
+        g = _glint(torch.acos(c_k.clamp(-1.0, 1.0)), phi, vx, vy, cxy, mx, my, n_, k_, tz, tp, e_sun, al, scene.shadowing)
+        if g1 is not None:
+            g = g * g1[m]
+        if tau_rows is not None:  # the path's transmittance: quadratic through the table's 3 nearest rows
+            tau_r, row = tau_rows
+            nr = tau_r.shape[1]
+            r = at(row).clamp(0.0, nr - 1.0)
+            i = r.detach().round().clamp(1, nr - 2).long()
+            t = r - i.to(r.dtype)
+            tm, t0, tq = (tau_r[m].index_select(0, i + d) for d in (-1, 0, 1))
+            g = g * (t0 + t * (0.5 * (tq - tm) + t * (0.5 * (tq + tm) - t0)))
+        return g
+
+    return _over_kept_pixels(keep, one, dtype)
+
+
+def _glint_core_table(scene: SeaScene, p: dict[str, Any], sl: slice, eps: torch.Tensor, lo: torch.Tensor,
+                      span_z: torch.Tensor, y_z: torch.Tensor, u_ab: tuple[torch.Tensor, torch.Tensor], y_cols: torch.Tensor,
+                      centre: torch.Tensor, sea_cols: torch.Tensor, scale_rows: torch.Tensor | None, table: TableSize,
+                      dtype: torch.dtype) -> tuple[torch.Tensor, torch.Tensor]:
+    """The smooth factor L_sun G1 / D of the glint of images ``sl`` (the glint is P ρ t · L_sun G1 / D,
+    ``roughsea_torch.sun._glint_sharp`` the sharp part, which :func:`_glint_sharp_pixels` evaluates per
+    pixel) on the fine table's sea rows and (unfolded, ratio) columns, times ``scale_rows`` (b, M_z)
+    (the path's τ, the foam's 1 − f); (b, M_z, M_o), and which images it serves (b,) bool (zero for the
+    others, whose glint stays wholly per pixel).
+
+    The factor is evaluated at ``table.glint``² Chebyshev–Lobatto nodes (in ζ over the sea rows' span,
+    in azimuth over every column) and resampled spectrally. An image is served when its pixels span
+    less than π in azimuth (the coordinate has period π, the glint has not) and, at the centres of the fine cells
+    of 48 rows and every other column (where bilinear reading errs most), the table's glint is within
+    ``table.glint_tolerance`` of direct evaluation, relative to the radiance there (``sea_cols``, the
+    sea's fine table, plus the glint).
+    """
+    from .sun import _glint, _glint_sharp, sun_masking_factor
+
+    Mz, device = y_z.shape[0], lo.device
+    B = p["vx"].shape[0]
+    sun = _relative_sun(scene, p, B, dtype, device, torch.arange(sl.start, sl.stop, device=device))
+    e = (slice(None), None, None)
+    per = [p[k][sl].to(dtype)[e] for k in ("vx", "vy", "cxy", "n", "k")]
+    tz, tp, e_sun, al = (v[e] for v in (sun.zenith, sun.azimuth, sun.irradiance, sun.radius))
+    g1 = None
+    if scene.sun_masking:
+        g1 = sun_masking_factor(SlopeStatistics.from_variances(p["vx"][sl], p["vy"][sl], p["cxy"][sl]), sun, dtype,
+                                device)[e]
+    zero = torch.zeros((), dtype=dtype, device=device)
+
+    def angles(zeta: torch.Tensor, o: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:  # ζ (b, R), o (b, C), float64
+        th = torch.acos((eps[:, None] * torch.sinh(zeta)).clamp(0.0, 1.0)).to(dtype)[:, :, None]
+        return th, (centre[:, None] + o - math.pi / 2).to(dtype)[:, None, :]
+
+    def smooth(th: torch.Tensor, ph: torch.Tensor) -> torch.Tensor:
+        r = _glint(th, ph, per[0], per[1], per[2], None, None, per[3], per[4], tz, tp, e_sun, al, scene.shadowing,
+                   smooth=True)
+        return r if g1 is None else r * g1
+
+    def sharp(th: torch.Tensor, ph: torch.Tensor) -> torch.Tensor:
+        return _glint_sharp(torch.cos(th), torch.sin(th), torch.cos(ph), torch.sin(ph), per[0], per[1], per[2], zero, zero,
+                            per[3], per[4], tz, tp, al)[0]
+
+    n = int(table.glint)
+    xg, L_rows, _ = _lobatto_interp(n, Mz)  # rows: nodes over the sea span, the fine rows' overhang two cells
+    # (the factor has a kink at the horizon, ζ = 0, where the overhang below it holds θ̂ = 90°)
+    xg_t = torch.as_tensor(xg, dtype=torch.float64, device=device)
+    u_a, u_b = u_ab
+    ang = _angle_of_ratio(u_a[:, None] + (u_b - u_a)[:, None] * (y_cols + 1) / 2, False)
+    a0, a1 = ang[:, 0], ang[:, -1]  # columns: nodes over every column, overhang included (it has no kink,
+    # and a polynomial of this degree must not be extrapolated by the columns' coarser cells)
+    th_n, ph_n = angles(lo[:, None] + span_z[:, None] * (xg_t + 1) / 2, a0[:, None] + (a1 - a0)[:, None] * (xg_t + 1) / 2)
+    r_nodes = smooth(th_n, ph_n)
+    L_rows = torch.as_tensor(L_rows, dtype=dtype, device=device)
+    L_cols = _barycentric(xg, 2.0 * (ang - a0[:, None]) / (a1 - a0)[:, None] - 1.0).to(dtype)
+    fine = L_rows @ r_nodes @ L_cols.transpose(1, 2)
+    if scale_rows is not None:
+        fine = fine * scale_rows[:, :, None]
+    with torch.no_grad():  # the check
+        i = torch.linspace(_EXT, Mz - 2 - _EXT, 48, device=device).round().long().unique()  # rows pixels read
+        j = torch.arange(0, y_cols.shape[0] - 1, 2, device=device)
+        th, ph = angles(lo[:, None] + span_z[:, None] * (0.5 * (y_z[i] + y_z[i + 1]) + 1) / 2,
+                        _angle_of_ratio(u_a[:, None] + (u_b - u_a)[:, None] * (0.5 * (y_cols[j + 1] + y_cols[j]) + 1) / 2,
+                                        False))
+        r_c, s_c = smooth(th, ph), sharp(th, ph)
+        if scale_rows is not None:
+            r_c = r_c * (0.5 * (scale_rows[:, i] + scale_rows[:, i + 1]))[:, :, None]
+        cell = lambda t: 0.25 * (t[:, i][:, :, j + 1] + t[:, i][:, :, j] + t[:, i + 1][:, :, j + 1]  # noqa: E731
+                                 + t[:, i + 1][:, :, j])
+        err = (cell(fine) - r_c).abs() * s_c / (cell(sea_cols).abs() + r_c.abs() * s_c)
+        ok = ((err.flatten(1).amax(1) < table.glint_tolerance) & ((a1 - a0) < math.pi - 1e-3)
+              & torch.isfinite(r_nodes).flatten(1).all(1))
+    return torch.where(ok[:, None, None], fine, torch.zeros_like(fine)), ok
+
+
+def _glint_sharp_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Tensor, dx: torch.Tensor,
+                        dy: torch.Tensor, sea: torch.Tensor) -> torch.Tensor:
+    """P ρ t at the sea pixels that can see glint (:func:`_glint_mask`) (b, H, W), 0 elsewhere: the
+    glint's part that is sharp in the view direction (``roughsea_torch.sun._glint_sharp``, the ellipse's probability in closed form or by rays
+    as it is small or not), for the pixel's line of sight, whose azimuth in the upwind frame comes from
+    the ray's world components: (cos φ̂, sin φ̂) = −(dx, dy)/|(dx, dy)| turned by −wind_direction."""
+    from .sun import _glint_sharp
+
+    dtype, device = cos_t.dtype, cos_t.device
+    b_, H, W = cos_t.shape
+    B = p["vx"].shape[0]
+    sun = _relative_sun(scene, p, B, dtype, device, torch.arange(sl.start, sl.stop, device=device))
+    wd = p["wind_direction"][sl].to(dtype)
+    per_img = [torch.cos(wd), torch.sin(wd), *(p[k][sl].to(dtype) for k in ("vx", "vy", "cxy", "n", "k")), sun.zenith,
+               sun.azimuth, sun.radius]
+    zero = torch.zeros((), dtype=dtype, device=device)
+
+    def one(m: int, at: Any) -> torch.Tensor:
+        cw, sw, vx, vy, cxy, n_, k_, tz, tp, al = (v[m] for v in per_img)
+        c, x, y = at(cos_t), at(dx), at(dy)
+        inv = torch.rsqrt((x * x + y * y).clamp_min(1e-30))
+        cph = -(x * cw + y * sw) * inv  # x' = x cos wd + y sin wd, y' = −x sin wd + y cos wd
+        sph = (x * sw - y * cw) * inv
+        return _glint_sharp(c, torch.sqrt((1.0 - c * c).clamp_min(0.0)), cph, sph, vx, vy, cxy, zero, zero, n_, k_, tz, tp,
+                            al)[0]
+
+    return _over_kept_pixels(_glint_mask(p, sl, sun, cos_t, dx, dy, sea), one, dtype)
 
 
 def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str, Any], scene: SeaScene,
@@ -1273,6 +1422,7 @@ def _render_table(
             wf = tex.field(sl, p)
             delta = tex.node_delta(sl, p, wf, ph_nodes, sky, scene, q, altitude,
                                    earth_radius_m, eps[sl], lo, span_z)
+        glint_tab = None  # (b,) bool: images whose glint the fine table holds (sunny, unfolded, no texture)
         # textured seas put their whitecaps on the crests, a fraction f_pix per pixel: the fine table
         # then carries the foam-free sea and the foam as two channels, mixed per pixel
         crest = textured and delta is not None and p["foam"] is not None
@@ -1330,11 +1480,20 @@ def _render_table(
                 ang = _angle_of_ratio(u_a[:, None] + (u_b - u_a)[:, None] * (y + 1) / 2, fold)
                 L_cols = _barycentric(xp, 2.0 * (ang - a[:, None]) / (b - a)[:, None] - 1.0).to(dtype)
                 sea_cols = sea_rows @ L_cols.transpose(1, 2)
+                if sunny and not (fold or textured):  # the glint's smooth factor, where the table resolves it
+                    scale = None if scene.path is None else tau.to(dtype)
+                    if p["foam"] is not None:
+                        f = 1.0 - p["foam"][sl].to(dtype)[:, None]
+                        scale = f.expand(b_, Mz) if scale is None else scale * f
+                    r_glint, glint_tab = _glint_core_table(scene, p, sl, eps[sl], lo, span_z, y_z, (u_a, u_b), y,
+                                                           rg.centre, sea_cols, scale, table, dtype)
             else:
                 sea_cols = sea_rows @ Lp_t.T
             fine = torch.cat([sea_cols, sky_rows[:, :, None].expand(-1, -1, Lp_t.shape[0])], 1)
         if crest:  # channel 1: the foam (sky rows alike), one grid_sample reads both
             fine = torch.stack([fine, torch.cat([foam_rows, sky_rows], 1)[:, :, None].expand_as(fine)], 1)
+        elif glint_tab is not None and bool(glint_tab.any()):  # channel 1: the glint's smooth factor (0 on sky rows)
+            fine = torch.stack([fine, torch.cat([r_glint, torch.zeros_like(fine[:, Mz:])], 1)], 1)
         else:
             fine = fine[:, None]
 
@@ -1406,8 +1565,11 @@ def _render_table(
         # reads it as fast, and planes stack ~4x faster than interleaved pairs.
         vals = F.grid_sample(fine, torch.stack([gx, gy], 1).permute(0, 2, 3, 1), mode="bilinear",
                              padding_mode="border", align_corners=True)
+        r_vals = None
         if crest:
             vals, foam_vals = vals[:, 0], vals[:, 1]
+        elif fine.shape[1] == 2:  # the glint's smooth factor, times its Gaussian core below
+            vals, r_vals = vals[:, 0], vals[:, 1]
         else:
             vals = vals[:, 0]
         if day is not None and has_sky:  # the scattered sky of the sky pixels, by zenith and azimuth, at them alone
@@ -1423,12 +1585,15 @@ def _render_table(
                                                              span_z, a, b, altitude, earth_radius_m, eps[sl], crest=crest)
             vals = vals + texture
             resolved = (x_pix, cov_pix)
-        if sunny:
+        if r_vals is not None:
+            vals = vals + r_vals * _glint_sharp_pixels(scene, p, sl, cos_t, dx, dy, sea)
+        if sunny and (glint_tab is None or not bool(glint_tab.all())):  # the rest per pixel
             rows = None
             if scene.path is not None:  # each pixel's fractional sea row of the fine table
                 rows = (tau.to(dtype), (zeta - (lo - ez * span_z / 2).to(dtype)[:, None, None])
                         * ((Mz - 1) / (span_z * (1.0 + ez))).to(dtype)[:, None, None])
-            glint = _glint_pixels(scene, p, sl, cos_t, dx, dy, sea, rows, resolved)
+            glint = _glint_pixels(scene, p, sl, cos_t, dx, dy, sea if glint_tab is None else sea & ~glint_tab[:, None, None],
+                                  rows, resolved)
             if p["foam"] is not None and not crest:
                 glint = glint * (1.0 - p["foam"][sl].to(dtype))[:, None, None]
             vals = vals + glint

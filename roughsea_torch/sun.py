@@ -218,33 +218,23 @@ def glint_radiance(view_zenith: Any, view_azimuth: Any, slopes: Any, refractive_
     return out
 
 
-def _glint(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor,
-           mx: torch.Tensor | None, my: torch.Tensor | None, n: torch.Tensor, k: torch.Tensor, tz: torch.Tensor,
-           tp: torch.Tensor, e_sun: torch.Tensor, alpha: torch.Tensor, shadowing: bool) -> torch.Tensor:
-    """:func:`glint_radiance` without the sun's masking, on checked tensors (the renderer calls it on
-    its own pixels, whose values need no second check)."""
-    from .expectation import _denominator, _geometry
-    from .optics import _fresnel_terms
-
-    dtype, device = vz.dtype, vz.device
-    zero = torch.zeros((), dtype=dtype, device=device)
-    if mx is None:
-        mx = my = zero
-    ct, st = torch.cos(vz), torch.sin(vz)
-    v = (st * torch.cos(va), st * torch.sin(va), ct)
+def _specular_ellipse(ct: torch.Tensor, st: torch.Tensor, cph: torch.Tensor, sph: torch.Tensor, vx: torch.Tensor,
+                      vy: torch.Tensor, cxy: torch.Tensor, mx: torch.Tensor, my: torch.Tensor, tz: torch.Tensor,
+                      tp: torch.Tensor, alpha: torch.Tensor) -> tuple[torch.Tensor, ...]:
+    """The sun's image in whitened slope space for lines of sight of cos/sin θ̂ (``ct``, ``st``) and
+    cos/sin φ̂ (``cph``, ``sph``): (c_x, c_y, K₁₁, K₁₂, K₂₂, det K, l₁₁, l₂₁, l₂₂, above), the ellipse
+    E' = {z : (z − c)ᵀ K (z − c) ≤ 1} about the whitened specular slope c, the Cholesky factor L of
+    Σ, and whether the sun is above the horizon (module docstring)."""
     cs, ss = torch.cos(tz), torch.sin(tz)
     cp, sp = torch.cos(tp), torch.sin(tp)
     above = cs > 0
     csp = torch.where(above, cs, torch.ones_like(cs))  # keep the sun's arithmetic finite below the horizon
-    w = (ss * cp, ss * sp, csp)
-    p = tuple(a + b for a, b in zip(v, w))
-    q = p[2]
-    sgx, sgy = p[0] / q, p[1] / q  # the specular slope s_g (facet normal ∝ (s, 1))
-    # the disk's tangent basis at ω_sun and the Jacobian ∂s/∂u (2×2), u the disk's offset [rad]
-    e1 = (csp * cp, csp * sp, -ss)
-    e2 = (-sp, cp, torch.zeros_like(sp))
-    j11, j21 = (e1[0] - sgx * e1[2]) / q, (e1[1] - sgy * e1[2]) / q
-    j12, j22 = (e2[0] - sgx * e2[2]) / q, (e2[1] - sgy * e2[2]) / q
+    q = ct + csp
+    sgx, sgy = (st * cph + ss * cp) / q, (st * sph + ss * sp) / q  # the specular slope s_g (facet normal ∝ (s, 1))
+    # the disk's tangent basis at ω_sun, e1 = (cs cp, cs sp, −ss), e2 = (−sp, cp, 0), and the
+    # Jacobian ∂s/∂u (2×2), u the disk's offset [rad]
+    j11, j21 = (csp * cp + sgx * ss) / q, (csp * sp + sgy * ss) / q
+    j12, j22 = -sp / q, cp / q
     # whitened slopes: z = L⁻¹ (s − μ), Σ = L Lᵀ (floors keep a flat sea finite)
     floor = 1e-24
     l11 = torch.sqrt(vx.clamp_min(floor))
@@ -263,26 +253,59 @@ def _glint(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tenso
     k12 = (n11 * n12 + n21 * n22) * inv_a2
     k22 = (n12 * n12 + n22 * n22) * inv_a2
     det_k = (l11 * l22 / (det_j * alpha * alpha)) ** 2  # det K = (det J⁻¹ det L / α²)², from the factors
+    return cxw, cyw, k11, k12, k22, det_k, l11, l21, l22, above
+
+
+def _glint_sharp(ct: torch.Tensor, st: torch.Tensor, cva: torch.Tensor, sva: torch.Tensor, vx: torch.Tensor,
+                 vy: torch.Tensor, cxy: torch.Tensor, mx: torch.Tensor, my: torch.Tensor, n: torch.Tensor, k: torch.Tensor,
+                 tz: torch.Tensor, tp: torch.Tensor, alpha: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """P ρ t of the glint (module docstring) for lines of sight of cos/sin θ̂ and cos/sin φ̂: the
+    Gaussian probability P of the sun's ellipse in slope space, and the Fresnel ρ and facet cosine t
+    at the mean slope s* of the facets that mirror the sun; the part of the glint that is sharp in the
+    view direction (the rest, L_sun / D, is smooth). Returns (P ρ t, whether the sun is above the
+    horizon)."""
+    from .optics import _fresnel_terms
+
+    cxw, cyw, k11, k12, k22, det_k, l11, l21, l22, above = _specular_ellipse(ct, st, cva, sva, vx, vy, cxy, mx, my,
+                                                                             tz, tp, alpha)
     shape = torch.broadcast_shapes(cxw.shape, cyw.shape, k11.shape, k12.shape, k22.shape, det_k.shape)
-    prob, mzx, mzy = _ellipse_probability(*(x.expand(shape) for x in (cxw, cyw, k11, k12, k22, det_k)))
+    ell = tuple(x.expand(shape) for x in (cxw, cyw, k11, k12, k22, det_k))
+    prob, mzx, mzy = _ellipse_probability(*ell)
     # t and ρ at s* = E[s | s ∈ E], the facets that actually mirror the sun: s_g + O(α²) for broad
     # slopes, the mean slope for a calm sea (a flat sea mirrors the sun with ρ(θ̂), not with the
     # ρ of the facet that would mirror the disk's centre: O(α tan θ̂) apart)
     ok = prob > 1e-300
     ps = torch.where(ok, prob, torch.ones_like(prob))
-    zx = torch.where(ok, mzx / ps, cxw.expand(shape))
-    zy = torch.where(ok, mzy / ps, cyw.expand(shape))
+    zx = torch.where(ok, mzx / ps, ell[0])
+    zy = torch.where(ok, mzy / ps, ell[1])
     s_x = mx + l11 * zx
     s_y = my + l21 * zx + l22 * zy
-    t_g = ct + st * (s_x * torch.cos(va) + s_y * torch.sin(va))
+    t_g = ct + st * (s_x * cva + s_y * sva)
     cos_omega = (t_g * torch.rsqrt(1.0 + s_x * s_x + s_y * s_y)).clamp(0.0, 1.0)
     rs_, rp_ = _fresnel_terms(cos_omega, n, k)
-    rho = 0.5 * (rs_ + rp_)
-    g = _geometry(vz, va, vx, vy, cxy, mx, my)
-    D = _denominator(g, shadowing)
+    return 0.5 * (rs_ + rp_) * t_g * prob, above
+
+
+def _glint(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor,
+           mx: torch.Tensor | None, my: torch.Tensor | None, n: torch.Tensor, k: torch.Tensor, tz: torch.Tensor,
+           tp: torch.Tensor, e_sun: torch.Tensor, alpha: torch.Tensor, shadowing: bool, smooth: bool = False) -> Any:
+    """:func:`glint_radiance` without the sun's masking, on checked tensors (the renderer calls it on
+    its own pixels, whose values need no second check): P ρ t L_sun / D (:func:`_glint_sharp`).
+    With ``smooth``, only the smooth factor L_sun / D (0 for a sun below the horizon), which the
+    renderer tabulates."""
+    from .expectation import _denominator, _geometry
+
+    dtype, device = vz.dtype, vz.device
+    zero = torch.zeros((), dtype=dtype, device=device)
+    if mx is None:
+        mx = my = zero
+    D = _denominator(_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
     l_sun = e_sun / (4.0 * math.pi * torch.sin(0.5 * alpha) ** 2)  # Ω_sun = 2π(1 − cos α), without cancellation
-    out = rho * t_g * l_sun * prob / D
-    return torch.where(above, out, torch.zeros_like(out))
+    if smooth:
+        return torch.where(torch.cos(tz) > 0, l_sun / D, zero)
+    sharp, above = _glint_sharp(torch.cos(vz), torch.sin(vz), torch.cos(va), torch.sin(va), vx, vy, cxy, mx, my, n,
+                                   k, tz, tp, alpha)
+    return torch.where(above, sharp * l_sun / D, zero)
 
 
 def sun_masking_factor(slopes: Any, sun: Sun, dtype: torch.dtype = torch.float64, device: Any = None) -> torch.Tensor:
