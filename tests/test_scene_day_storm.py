@@ -24,6 +24,16 @@ def test_sun_from_zenith_takes_the_lowtran_irradiance_of_the_scene_band():
                             sun_azimuth=0.0, aerosol=None)
         torch.testing.assert_close(clear.sun.irradiance, load_solar_irradiance("tropical", band)(z), rtol=1e-12, atol=0.0)
         assert bool((sc.sun.irradiance < 0.97 * clear.sun.irradiance).all())
+    # the irradiance is kept between reads, keyed by the fields' values: a changed field (a new
+    # tensor, the same tensor changed in place, another aerosol) takes effect
+    sc = rs.SeaScene(wind_speed=6.0, sea_temperature=290.0, band=rs.MWIR, sky="tropical", sun_zenith=z.clone(), sun_azimuth=0.0)
+    first = sc.sun.irradiance.clone()
+    sc.sun_zenith = z.flip(0)
+    torch.testing.assert_close(sc.sun.irradiance, first.flip(0), rtol=1e-12, atol=0.0)
+    sc.sun_zenith[0] = z[0]
+    torch.testing.assert_close(sc.sun.irradiance, first[0].expand(2), rtol=1e-12, atol=0.0)
+    sc.aerosol = None
+    torch.testing.assert_close(sc.sun.irradiance, load_solar_irradiance("tropical", rs.MWIR)(sc.sun_zenith), rtol=1e-12, atol=0.0)
     with pytest.raises(ValueError, match="sun_zenith"):
         rs.SeaScene(wind_speed=6.0, sea_temperature=290.0, sky=10.0, sun_zenith=0.5)
     with pytest.raises(ValueError, match="not both"):
