@@ -1053,24 +1053,29 @@ def _glint_mask(p: dict[str, Any], sl: slice, sun: Any, cos_t: torch.Tensor, dx:
     within 6 standard deviations (whitened) of the slope law, plus the sun disk's own extent (the rest
     carries less than exp(−18) = 1.5e-8 of the glint's peak), with the sun up. ``sun``: the images' sun
     relative to upwind."""
-    with torch.no_grad():
-        ct = cos_t.clamp(0.0, 1.0)
+    dtype = cos_t.dtype
+    per_img = [p[k][sl].to(dtype) for k in ("wind_direction", "vx", "vy", "cxy")] + [sun.zenith, sun.azimuth, sun.radius]
+
+    def one(m: int, at: Any) -> torch.Tensor:
+        wd, a2, b2, c2, sz, sa, radius = (v[m] for v in per_img)
+        ct = at(cos_t).clamp(0.0, 1.0)
+        x, y = at(dx), at(dy)
         st = torch.sqrt((1 - ct * ct).clamp_min(0.0))
-        inv = torch.rsqrt((dx * dx + dy * dy).clamp_min(1e-30))
-        wd = p["wind_direction"][sl, None, None]
+        inv = torch.rsqrt((x * x + y * y).clamp_min(1e-30))
         cw, sw = torch.cos(wd), torch.sin(wd)
-        ex, ey = -dx * inv, -dy * inv  # LOS azimuth (world) → the upwind frame
+        ex, ey = -x * inv, -y * inv  # LOS azimuth (world) → the upwind frame
         vx_, vy_ = st * (ex * cw + ey * sw), st * (ey * cw - ex * sw)
-        sz, sa = sun.zenith[:, None, None], sun.azimuth[:, None, None]
         wx, wy, wz = torch.sin(sz) * torch.cos(sa), torch.sin(sz) * torch.sin(sa), torch.cos(sz)
         qz = ct + wz
         sgx, sgy = (vx_ + wx) / qz, (vy_ + wy) / qz
-        a2, b2, c2 = (p[k][sl, None, None] for k in ("vx", "vy", "cxy"))
         det = (a2 * b2 - c2 * c2).clamp_min(1e-30)
         d2 = (b2 * sgx * sgx - 2 * c2 * sgx * sgy + a2 * sgy * sgy) / det
         lam_min = (0.5 * (a2 + b2 - torch.sqrt((a2 - b2) ** 2 + 4 * c2 * c2))).clamp_min(1e-24)
-        reach = sun.radius[:, None, None] * 2.0 * (1 + sgx * sgx + sgy * sgy) / qz.clamp_min(1e-6) / torch.sqrt(lam_min)
-        return sea & (wz > 0) & (torch.sqrt(d2) - reach < 6.0)
+        reach = radius * 2.0 * (1 + sgx * sgx + sgy * sgy) / qz.clamp_min(1e-6) / torch.sqrt(lam_min)
+        return ((wz > 0) & (torch.sqrt(d2) - reach < 6.0)).to(dtype)
+
+    with torch.no_grad():
+        return _over_kept_pixels(sea, one, dtype) > 0
 
 
 def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Tensor, dx: torch.Tensor,
