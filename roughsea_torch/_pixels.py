@@ -10,9 +10,10 @@ replaced when the chunk's shape, dtype or device changes (so it holds at most si
 of the last chunk rendered on that thread: 31 MB for chunks of 4 images of 512×640 in float32;
 :func:`release_workspace` frees them all).
 
-Only where no gradient flows through the pixels' rays (the cameras' pose and intrinsics do not
-require grad, or grad mode is off): in-place operations would otherwise overwrite what autograd
-saved. The grid passed to ``grid_sample`` is fresh memory when the table itself requires grad
+Only on the CPU, and only where no gradient flows through the pixels' coordinates (neither the
+cameras' pose and intrinsics nor the per-image maps, e.g. through ``wind_direction``; or grad mode
+is off): in-place operations would otherwise overwrite what autograd saved, and ``out=`` does not
+record gradients. The grid passed to ``grid_sample`` is fresh memory when the table itself requires grad
 (``grid_sample`` saves the grid for the table's gradient). The formulas are those of the general
 path in :func:`roughsea_torch.render._render_table` (the same table coordinates to rounding).
 """
@@ -46,6 +47,9 @@ def _workspace(b: int, H: int, W: int, dtype: torch.dtype, device: torch.device)
         planes = torch.empty(_PLANES, b, H, W, dtype=dtype, device=device)
     with _lock:
         _spaces[tid] = (key, planes)
+        alive = {t.ident for t in threading.enumerate()}
+        for t in [t for t in _spaces if t not in alive]:  # threads that have ended hold none
+            del _spaces[t]
     return planes
 
 

@@ -76,7 +76,8 @@ def _fresnel_terms(c: torch.Tensor, n: torch.Tensor, k: torch.Tensor, emission: 
     N = 2.0 * n * k
     A = M - (1.0 - c * c)  # Re(m² − sin² i)
     mod = torch.sqrt(A * A + N * N)
-    if bool((M > 1.0).all()):  # A ≥ M − 1 > 0 at every angle (water): p is the large component
+    if c.device.type == "cpu" and bool((M > 1.0).all()):  # A ≥ M − 1 > 0 at every angle (water): p is
+        # the large component (the check would stall a CUDA stream; there the general form below)
         p = torch.sqrt(0.5 * (mod + A))
         q = N / (2.0 * p)
     else:  # stable complex square root: the large component from a sum, the other from N / (2·it)

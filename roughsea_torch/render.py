@@ -272,12 +272,12 @@ class SeaScene:
         # the renderer reads the sun many times a call: keep the last one, keyed by the fields' values
         # (not when the zenith requires grad: its irradiance must join the caller's graph)
         grad = isinstance(z, torch.Tensor) and z.requires_grad
-        key = None if grad else (self.atmosphere, self.band.lo, self.band.hi, id(self.band.response), self.aerosol,
+        key = None if grad else (self.atmosphere, self.aerosol, torch.is_inference_mode_enabled(),
                                  (z.dtype, z.device, tuple(z.detach().flatten().tolist())) if isinstance(z, torch.Tensor)
                                  else float(z))
-        cached = self._sun_cache
-        if key is not None and cached is not None and cached[0] == key:
-            irr = cached[1]
+        cached = self._sun_cache  # (band, key, irradiance): the band compared by identity (it is kept alive)
+        if key is not None and cached is not None and cached[0] is self.band and cached[1] == key:
+            irr = cached[2].clone() if isinstance(cached[2], torch.Tensor) else cached[2]
         else:
             e = load_solar_irradiance(self.atmosphere, (self.band.lo, self.band.hi), self.band.response,
                                       aerosol=self.aerosol)
@@ -285,7 +285,7 @@ class SeaScene:
             irr = e(zt)
             if isinstance(z, torch.Tensor):
                 irr = irr.to(z.dtype)
-            self._sun_cache = None if key is None else (key, irr)
+            self._sun_cache = None if key is None else (self.band, key, irr.clone() if isinstance(irr, torch.Tensor) else irr)
         return Sun(z, self.sun_azimuth, irr if isinstance(z, torch.Tensor) else float(irr))
 
     @sun.setter
@@ -476,7 +476,9 @@ class TableSize:
             the sharp factor P ρ t itself (the sun's ellipse probability in slope space, Fresnel and
             facet cosine at the facets that mirror the sun). An image whose table misses
             ``glint_tolerance`` of the radiance at the fine cells' centres (checked against direct
-            evaluation) keeps the whole glint per pixel.
+            evaluation) keeps the whole glint per pixel. In float32 the check measures float32
+            evaluations, so it bounds the table's error only down to float32's own rounding of the
+            glint (which near the horizon exceeds 1e-5 of the radiance at low sun and calm seas).
         glint_tolerance: see ``glint``.
         fine_zenith, fine_azimuth: rows/columns of the fine table read by ``grid_sample``.
         fine_azimuth_thin: columns of the fine table when a slope ellipse is thin (64 columns leave
@@ -1513,14 +1515,19 @@ def _render_table(
                                    (math.pi / 2 - rg.centre - wd.double()).to(dtype))
         # the main path (cameras, no texture or sun, no gradient through the rays): in place, in a
         # reused workspace (roughsea_torch._pixels)
+        # (on the CPU, where fresh memory page-faults; CUDA has its caching allocator and streams)
         xy = (None if geometry is not None or textured or sunny or (not iso and not ratio) or cg.requires_grad
-              else cg.separable_xy(sl))
+              or device.type != "cpu" else cg.separable_xy(sl))
         if xy is not None:
             c1 = (inv_eps[sl] if cg.flat else cg.k_r[sl].to(dtype) * inv_eps[sl])[:, None, None]
             sh = cg.s_h[sl, None, None] if not cg.flat else torch.zeros_like(c1)
             az = None if iso else dict(offset=offset, fold=fold,
                                        k=(2.0 / ((u_b - u_a) * (1.0 + ep))).to(dtype)[:, None, None],
                                        b=((-2.0 * u_a / (u_b - u_a) - 1.0) / (1.0 + ep)).to(dtype)[:, None, None])
+            per_image = [c1, sh, k_sea, b_sea, k_sky, b_sky] + ([] if az is None else [az["offset"], az["k"], az["b"]])
+            if torch.is_grad_enabled() and any(t.requires_grad for t in per_image):
+                xy = None  # a gradient through the per-image maps (e.g. wind_direction): the general path
+        if xy is not None:
             grid, seaf = table_grid(cg, sl, xy, c1, sh, (k_sea, b_sea), (k_sky, b_sky) if has_sky else None, az,
                                     fresh_grid=torch.is_grad_enabled() and fine.requires_grad)
             vals = F.grid_sample(fine, grid, mode="bilinear", padding_mode="border", align_corners=True)[:, 0]

@@ -7,6 +7,7 @@ import pytest
 import torch
 
 import roughsea_torch as rs
+from roughsea_torch.radiometry import as_band
 from roughsea_torch.solar import load_solar_irradiance
 
 
@@ -34,6 +35,17 @@ def test_sun_from_zenith_takes_the_lowtran_irradiance_of_the_scene_band():
     torch.testing.assert_close(sc.sun.irradiance, first[0].expand(2), rtol=1e-12, atol=0.0)
     sc.aerosol = None
     torch.testing.assert_close(sc.sun.irradiance, load_solar_irradiance("tropical", rs.MWIR)(sc.sun_zenith), rtol=1e-12, atol=0.0)
+    # another band (a new object, whatever its response), a caller changing what it got, inference mode
+    narrow = as_band((4.4e-6, 4.9e-6))
+    sc.band = narrow
+    torch.testing.assert_close(sc.sun.irradiance, load_solar_irradiance("tropical", narrow)(sc.sun_zenith), rtol=1e-12, atol=0.0)
+    sc.sun.irradiance.mul_(2.0)
+    torch.testing.assert_close(sc.sun.irradiance, load_solar_irradiance("tropical", narrow)(sc.sun_zenith), rtol=1e-12, atol=0.0)
+    with torch.inference_mode():
+        sc.sun.irradiance
+    w = torch.ones(2, dtype=torch.float64, requires_grad=True)
+    (sc.sun.irradiance * w).sum().backward()
+    assert w.grad is not None
     with pytest.raises(ValueError, match="sun_zenith"):
         rs.SeaScene(wind_speed=6.0, sea_temperature=290.0, sky=10.0, sun_zenith=0.5)
     with pytest.raises(ValueError, match="not both"):
