@@ -87,7 +87,10 @@ def visible_slope(
     Returns:
         a' (..., n): F_p⁻¹(Φ(x)) with p(a') ∝ N(a'; 0, σ_a²) D_u(a'), D_u(a') = E[t H(t)],
         t = cos θ̂ + sin θ̂ (a' + σ_u z). Computed on a fixed grid in a'/σ_a (cumulative trapezoid,
-        linear inverse; error ~1e-5 σ_a), differentiable in every argument. σ_a = 0 gives 0.
+        linear inverse), differentiable in every argument. σ_a = 0 gives 0. Error against a 16-times
+        finer grid, over random x within ±4.5, σ_a 0.01–0.21, σ_u 0.005–0.205, cos θ̂ 0.001–1: median
+        3e-5 σ_a; up to 3.4e-4 σ_a (cos θ̂ > 0.2) and 1.6e-3 σ_a (grazing) where σ_u ≪ σ_a, at the
+        quantiles in the tail where the visible density nearly vanishes (facets turned away).
     """
     out_dtype, device = x.dtype, x.device
     shape = torch.broadcast_shapes(x.shape[:-1], cos_t.shape, sin_t.shape, sigma_r.shape, sigma_u.shape)

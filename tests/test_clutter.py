@@ -237,3 +237,23 @@ def test_textured_scene_needs_wind_speed_and_valid_seed():
         rs.SeaScene(wind_speed=5.0, sea_temperature=290.0, seed=-1)
     with pytest.raises(ValueError, match="seed"):
         rs.SeaScene(wind_speed=5.0, sea_temperature=290.0, seed=1.5)
+
+
+def test_visible_slope_grid_error_against_a_finer_grid():
+    """clutter.visible_slope's default 1025-node grid against a 16-times finer one, over random
+    quantiles within ±4.5, σ_a 0.01–0.21, σ_u 0.005–0.205, cos θ̂ 0.001–1 (its docstring's figures):
+    median error 3e-5 σ_a, worst 1.6e-3 σ_a (grazing, σ_u ≪ σ_a, deep in the tail where the visible
+    density nearly vanishes). This seeded sample of 300: median 2.7e-5 σ_a, worst 3.1e-4 σ_a; asserted
+    1e-4 and 1e-3 (a 257-node grid, planted, gives 4.4e-4 and 5.0e-3)."""
+    from roughsea_torch.clutter import visible_slope
+
+    g = torch.Generator().manual_seed(0)
+    n = 300
+    x = torch.randn(n, 9, generator=g, dtype=torch.float64).clamp(-4.5, 4.5)
+    ct = 0.001 + 0.999 * torch.rand(n, generator=g, dtype=torch.float64)
+    st = torch.sqrt(1 - ct ** 2)
+    sr = 0.01 + 0.2 * torch.rand(n, generator=g, dtype=torch.float64)
+    su = 0.005 + 0.2 * torch.rand(n, generator=g, dtype=torch.float64)
+    err = (visible_slope(x, ct, st, sr, su) - visible_slope(x, ct, st, sr, su, nodes=16385)).abs() / sr[:, None]
+    assert float(err.median()) < 1e-4
+    assert float(err.max()) < 1e-3
