@@ -147,19 +147,29 @@ def unresolved_statistics(
 
 def two_scale_statistics(
     vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor, phi: torch.Tensor, cos_t: torch.Tensor,
-    x: torch.Tensor, var_a: torch.Tensor, kappa: torch.Tensor,
-) -> SlopeStatistics:
+    x: torch.Tensor, var_a: torch.Tensor, kappa: torch.Tensor, visible: torch.Tensor | None = None,
+    return_visible: bool = False,
+) -> Any:
     """The unresolved statistics of pixels (or table nodes) whose resolved along-view slope sits at
     the flat-point quantile ``x`` (shape (..., n) against the others' (...)): the along-view
     unresolved rms σ_u = √(êᵀΣê − σ_a²), the visible slope a' (:func:`visible_slope`) and
     :func:`unresolved_statistics`. The one place the renderer builds them (table nodes, per-pixel
-    evaluation, glint)."""
+    evaluation, glint).
+
+    ``visible``: the visible quantile x' = a'/σ_a where the caller has it already (the renderer reads
+    it from its texture volume), instead of inverting :func:`visible_slope`'s distribution here.
+    ``return_visible``: also return x' (shape of ``x``)."""
     c, s = torch.cos(phi), torch.sin(phi)
-    sig_u = torch.sqrt((vx * c * c + 2.0 * cxy * c * s + vy * s * s - var_a).clamp_min(1e-30))
-    sin_t = torch.sqrt((1.0 - cos_t * cos_t).clamp_min(0.0))
-    ap = visible_slope(x, cos_t, sin_t, torch.sqrt(var_a.clamp_min(1e-30)), sig_u)
+    sig_a = torch.sqrt(var_a.clamp_min(1e-30))
+    if visible is None:
+        sig_u = torch.sqrt((vx * c * c + 2.0 * cxy * c * s + vy * s * s - var_a).clamp_min(1e-30))
+        sin_t = torch.sqrt((1.0 - cos_t * cos_t).clamp_min(0.0))
+        ap = visible_slope(x, cos_t, sin_t, sig_a, sig_u)
+    else:
+        ap = visible * sig_a[(...,) + (None,) * (visible.ndim - sig_a.ndim)]
     e = (...,) + (None,) * (ap.ndim - phi.ndim)
-    return unresolved_statistics(vx[e], vy[e], cxy[e], phi[e], var_a[e], kappa[e], ap)
+    stats = unresolved_statistics(vx[e], vy[e], cxy[e], phi[e], var_a[e], kappa[e], ap)
+    return (stats, ap / sig_a[e]) if return_visible else stats
 
 
 def along_view(cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], ex: torch.Tensor, ey: torch.Tensor
@@ -246,7 +256,9 @@ class TextureTable:
         xx, Lx, self.ex = _lobatto_interp(int(table.texture), int(table.fine_texture))
         self.xnodes = torch.as_tensor(xx * self.width, dtype=dtype, device=device)
         self.Lx = torch.as_tensor(Lx, dtype=dtype, device=device)
-        xz, Lz, self.ez = _lobatto_interp(int(table.texture_zenith), int(table.fine_texture_zenith))
+        # with a sun the volume also carries the glint's visible quantile, which needs more ζ nodes
+        nz = int(table.texture_zenith) if scene.sun is None else max(int(table.texture_zenith), int(table.texture_zenith_sun))
+        xz, Lz, self.ez = _lobatto_interp(nz, int(table.fine_texture_zenith))
         self.xz = torch.as_tensor(xz, dtype=torch.float64, device=device)
         self.Lz = torch.as_tensor(Lz, dtype=dtype, device=device)
         _, La, self.ea = _lobatto_interp(nphi, int(table.fine_texture_azimuth))
@@ -280,8 +292,10 @@ class TextureTable:
     def node_delta(self, sl: slice, p: dict, wf: Any, ph_nodes: torch.Tensor, sky: Any, scene: Any, q: Any,
                    altitude: torch.Tensor, earth_radius_m: float, eps: torch.Tensor, lo: torch.Tensor,
                    span_z: torch.Tensor) -> torch.Tensor | None:
-        """The fine texture volume (b, fine_texture, fine_texture_zenith, fine_texture_azimuth), τ
-        included; None when no node of the chunk resolves any wave."""
+        """The fine texture volume (b, C, fine_texture, fine_texture_zenith, fine_texture_azimuth), τ
+        included, C = 1, or 2 with a sun (channel 1: the visible quantile x' = a'/σ_a that the glint's
+        unresolved Gaussian is centred on, read per pixel instead of inverting :func:`visible_slope`'s
+        distribution at every pixel); None when no node of the chunk resolves any wave."""
         from .expectation import _reflection_terms
         from .render import _sky_per_image, _slant_range
         from .sky import TabulatedSky, select_sky
@@ -311,8 +325,8 @@ class TextureTable:
         va_, kp_ = full(var_a), full(kap)
         ct = full(cos_n[:, :, None])
         ph = full(ph_nodes[:, None, :])
-        shifted = two_scale_statistics(vx[img, 0, 0], vy[img, 0, 0], cxy[img, 0, 0], ph, ct, self.xnodes.expand(img.numel(), -1),
-                                       va_, kp_)  # (M, nx)
+        shifted, x_vis = two_scale_statistics(vx[img, 0, 0], vy[img, 0, 0], cxy[img, 0, 0], ph, ct,
+                                              self.xnodes.expand(img.numel(), -1), va_, kp_, return_visible=True)  # (M, nx)
         # one more column, the expectation itself (nothing resolved), on the same quadrature: Δ is
         # the difference of two evaluations whose quadrature errors nearly cancel, so the texture
         # nodes can take a coarser rule than the mean table (TableSize.texture_quadrature)
@@ -337,14 +351,20 @@ class TextureTable:
         v = rb - rb * t_rho + t_s
         delta = torch.zeros(b_, nz, nphi, self.xnodes.numel(), dtype=dtype, device=device)
         delta = delta.index_put(idx, (v[:, :-1] - v[:, -1:]).to(dtype))
-        vol = torch.einsum("rz,bzpx,ap,fx->bfra", self.Lz, delta, self.La, self.Lx)
+        if scene.sun is not None:  # channel 1: the visible quantile x' = a'/σ_a, for the glint (x' = x where
+            # nothing is resolved: unused there)
+            xv = self.xnodes.expand(b_, nz, nphi, -1).clone().index_put(idx, x_vis.to(dtype))
+            delta = torch.stack([delta, xv], 1)
+        else:
+            delta = delta[:, None]
+        vol = torch.einsum("rz,bczpx,ap,fx->bcfra", self.Lz, delta, self.La, self.Lx)
         if scene.path is not None:
             Mt = self.Lz.shape[0]
             y = torch.linspace(-1.0 - self.ez, 1.0 + self.ez, Mt, dtype=torch.float64, device=device)
             cos_rows = (eps[:, None] * torch.sinh(lo[:, None] + span_z[:, None] * (y + 1) / 2)).clamp(0.0, 1.0).to(dtype)
             tau, _ = scene.path(h[:, None].expand_as(cos_rows), _slant_range(cos_rows, h[:, None], earth_radius_m),
                                 clamp=True)
-            vol = vol * tau.to(dtype)[:, None, :, None]
+            vol = torch.cat([vol[:, :1] * tau.to(dtype)[:, None, None, :, None], vol[:, 1:]], 1)
         return vol
 
     def pixels(self, sl: slice, p: dict, wf: Any, vol: torch.Tensor, cos_t: torch.Tensor,
@@ -389,9 +409,12 @@ class TextureTable:
         a_, b2 = a.to(dtype)[:, None, None], b.to(dtype)[:, None, None]
         gx = (2.0 * (o - a_) / (b2 - a_) - 1.0) / (1.0 + self.ea)
         grid = torch.stack([gx, gy, gz], -1)[:, None]  # (b, 1, H, W, 3): x → W (azimuth), y → H (ζ), z → D (x)
-        out = F.grid_sample(vol[:, None], grid, mode="bilinear", padding_mode="border", align_corners=True)[:, 0, 0]
-        # x and the resolved covariance go back too: the glint of the same realization needs them
-        result = (torch.where(sea, out, torch.zeros_like(out)), x, (cov[:, 0], cov[:, 1], cov[:, 2]))
+        read = F.grid_sample(vol, grid, mode="bilinear", padding_mode="border", align_corners=True)[:, :, 0]
+        out = read[:, 0]
+        # x (or, with a sun, the visible quantile x' read from channel 1) and the resolved covariance go
+        # back too: the glint of the same realization needs them
+        result = (torch.where(sea, out, torch.zeros_like(out)), x if vol.shape[1] == 1 else (x, read[:, 1]),
+                  (cov[:, 0], cov[:, 1], cov[:, 2]))
         if crest:
             zero = torch.zeros_like(out)
             result = result + ((torch.where(sea, smp["crest"], zero), torch.where(sea, cov[:, 3], zero),

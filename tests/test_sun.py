@@ -236,8 +236,11 @@ def test_glint_of_the_two_scales_averages_to_the_expectation_glint(th_deg, sun_d
 
 
 def test_textured_glint_table_matches_per_pixel():
-    """A textured MWIR sea with the sun ahead: table render against per-pixel evaluation (the glint is
-    per pixel in both; the texture volume's interpolation remains), 3e-4; the glint carries texture."""
+    """A textured MWIR sea with the sun ahead: table render against per-pixel evaluation, 2e-4 (4.8e-5
+    measured; the glint is per pixel in both, the table's reading its pixel's visible quantile x' from
+    the texture volume where per-pixel evaluation inverts the visible-slope distribution; with the
+    night's 33 texture ζ nodes, TableSize.texture_zenith_sun planted at 33, 3.8e-4); the glint carries
+    texture."""
     cams = rs.make_camera(24, 32, hfov_deg=20.0, altitude_m=15.0, pitch_deg=-6.0, batch_size=2, dtype=torch.float64)
     sun = rs.Sun(torch.tensor([math.radians(75.0), math.radians(80.0)], dtype=torch.float64), 0.0, 12.0)
 
@@ -246,7 +249,7 @@ def test_textured_glint_table_matches_per_pixel():
                            path=False, sky=1.0)
 
     table, direct, mean = rs.render(cams, scene([1, 2])), rs.render(cams, scene([1, 2]), method="direct"), rs.render(cams, scene(None))
-    assert float(((table - direct) / direct).abs().max()) < 3e-4
+    assert float(((table - direct) / direct).abs().max()) < 2e-4
     assert float((table / mean).max()) > 1.2 and float((table / mean).min()) < 0.8
 
 
