@@ -69,3 +69,18 @@ def map_chunks(fn: Callable[[Any], T], items: Sequence[Any], device: torch.devic
             _local.worker = False
 
     return list(_pool(n).map(run, items))
+
+
+def one_thread(fn: Callable[[], T], device: torch.device | str | None) -> T:
+    """``fn()`` with one intra-op thread on the CPU (the caller's setting restored after), for work
+    whose few large operations gain little from a second thread on an idle machine and stall on
+    shared cores (see the module docstring); elsewhere, or inside a worker, ``fn()`` as it is."""
+    n = torch.get_num_threads()
+    dev = torch.device(device) if device is not None else torch.device("cpu")
+    if dev.type != "cpu" or n <= 1 or getattr(_local, "worker", False) or not _openmp_backend():
+        return fn()
+    torch.set_num_threads(1)
+    try:
+        return fn()
+    finally:
+        torch.set_num_threads(n)

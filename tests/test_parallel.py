@@ -58,3 +58,30 @@ def test_autograd_mode_reaches_the_workers(two_threads):
     torch.set_num_threads(1)
     (g1,) = torch.autograd.grad(rs.render(_cams(), _scene(wind), chunk=1).sum(), wind)
     assert torch.equal(g1, g2) and bool((g1 != 0).all())
+
+
+def test_sensor_runs_on_one_thread_and_restores_the_setting():
+    """SensorModel runs its chain with one intra-op thread (roughsea_torch._parallel.one_thread): the
+    caller's thread count is restored afterwards, even when a stage raises, and the result equals the
+    one-thread result bit for bit."""
+    sensor = rs.SensorModel.typical_lwir()
+    x = rs.band_radiance(torch.full((3, 1, 16, 20), 295.0) + torch.rand(3, 1, 16, 20, generator=torch.Generator().manual_seed(1)))
+    gens = lambda: [torch.Generator().manual_seed(i) for i in range(3)]  # noqa: E731
+    before = torch.get_num_threads()
+    try:
+        torch.set_num_threads(1)
+        one = sensor(x, generator=gens())
+        torch.set_num_threads(2)
+        two = sensor(x, generator=gens())
+        assert torch.get_num_threads() == 2
+        assert torch.equal(one, two)
+        class Boom(torch.nn.Module):
+            def forward(self, image):
+                assert torch.get_num_threads() == 1  # the chain runs on one thread
+                raise RuntimeError("boom")
+
+        with pytest.raises(RuntimeError, match="boom"):
+            rs.SensorModel(blur=Boom())(x)
+        assert torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(before)
