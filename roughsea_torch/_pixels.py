@@ -25,7 +25,7 @@ from typing import Any
 
 import torch
 
-from .geometry import CameraGeometry, turned_axes
+from .geometry import CameraGeometry, _component, turned_axes
 
 __all__ = ["release_workspace"]
 
@@ -60,11 +60,6 @@ def release_workspace() -> None:
         _spaces.clear()
 
 
-def _component(a: torch.Tensor, x: torch.Tensor, y: torch.Tensor, out: torch.Tensor) -> torch.Tensor:
-    """a · (x, y, 1), unnormalized, into ``out``: a (b, 3) in camera axes, x (b, 1, W), y (b, H, 1)."""
-    return torch.add(a[:, 0, None, None] * x + a[:, 2, None, None], a[:, 1, None, None] * y, out=out)
-
-
 def table_grid(cg: CameraGeometry, sl: slice, xy: tuple[torch.Tensor, torch.Tensor], c1: torch.Tensor,
                sh: torch.Tensor, sea_map: tuple[torch.Tensor, torch.Tensor],
                sky_map: tuple[torch.Tensor, torch.Tensor] | None, az: dict[str, Any] | None,
@@ -89,7 +84,7 @@ def table_grid(cg: CameraGeometry, sl: slice, xy: tuple[torch.Tensor, torch.Tens
     A = cg.axes_cam[sl]
     # z = c1 dz, dz the unit ray's local-vertical component (c1 folded into the axis: no extra pass)
     torch.add(x * x, y * y + 1.0, out=P0).rsqrt_()
-    z = _component(c1[:, :, 0] * A[:, 2], x, y, P1).mul_(P0)
+    z = _component((c1[:, :, 0] * A[:, 2])[:, :, None, None], x, y, P0, out=P1)
     ch = c1 * sh
     torch.lt(z, -ch, out=seaf)
     # ζ = asinh √q = ½ log(2q + 1 + 2√(q² + q)), q = z² − (c1 sh)², held at a tiny q > 0 off the
@@ -107,7 +102,7 @@ def table_grid(cg: CameraGeometry, sl: slice, xy: tuple[torch.Tensor, torch.Tens
         gx.zero_()
     else:  # the ray's components along the world axes turned by −offset (unnormalized)
         A_t = turned_axes(A, az["offset"])
-        c, s = _component(A_t[:, 0], x, y, P0), _component(A_t[:, 1], x, y, gx)
+        c, s = (_component(A_t[:, i, :, None, None], x, y, None, out=o) for i, o in ((0, P0), (1, gx)))
         if az["fold"]:  # u = |c| / (|c| + |s|)
             c.abs_()
             s.abs_().add_(c).clamp_min_(1e-30)

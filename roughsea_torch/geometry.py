@@ -194,11 +194,13 @@ def turned_axes(A: torch.Tensor, offset: torch.Tensor) -> torch.Tensor:
     return torch.stack([co * A[:, 0] - so * A[:, 1], so * A[:, 0] + co * A[:, 1]], 1)
 
 
-def _component(a: torch.Tensor, x: torch.Tensor, y: torch.Tensor, inv: torch.Tensor | None) -> torch.Tensor:
+def _component(a: torch.Tensor, x: torch.Tensor, y: torch.Tensor, inv: torch.Tensor | None,
+               out: torch.Tensor | None = None) -> torch.Tensor:
     """a · (x, y, 1) / |(x, y, 1)|: a world axis ``a`` (b, 3, ...) in camera axes against the unit ray
-    of normalized image coordinates (x, y) (``inv`` = 1/|(x, y, 1)|), broadcast over (x, y)."""
-    out = (a[:, 0] * x + a[:, 2]) + a[:, 1] * y
-    return out if inv is None else out * inv
+    of normalized image coordinates (x, y) (``inv`` = 1/|(x, y, 1)|), broadcast over (x, y); into
+    ``out`` if given (the in-place renderer's workspace)."""
+    res = torch.add(a[:, 0] * x + a[:, 2], a[:, 1] * y, out=out)
+    return res if inv is None else (res.mul_(inv) if out is not None else res * inv)
 
 
 class CameraGeometry:

@@ -1522,22 +1522,25 @@ def _render_table(
         # the azimuth coordinate's offset: o = (ray azimuth + offset) mod π (folded: ψ = |o − π/2|)
         offset = None if iso else ((math.pi / 2 - wd).to(dtype) if fold else
                                    (math.pi / 2 - rg.centre - wd.double()).to(dtype))
+        if not iso:  # gx = b_az + k_az · (the azimuth coordinate: its ratio stand-in u, or the angle)
+            lo_a, hi_a = (u_a, u_b) if ratio else (a, b)
+            k_az = (2.0 / ((hi_a - lo_a) * (1.0 + ep))).to(dtype)[:, None, None]
+            b_az = ((-2.0 * lo_a / (hi_a - lo_a) - 1.0) / (1.0 + ep)).to(dtype)[:, None, None]
+        if cg is not None:  # per image: (cos θ̂/ε)² = c1² (dz² − s_h²), c1 = k_r/ε, s_h the horizon dip's sine
+            c1 = (inv_eps[sl] if cg.flat else cg.k_r[sl].to(dtype) * inv_eps[sl])[:, None, None]
+            sh = cg.s_h[sl, None, None] if not cg.flat else torch.zeros_like(c1)
         # the main path (cameras, no texture or sun, no gradient through the rays): in place, in a
         # reused workspace (roughsea_torch._pixels)
         # (on the CPU, where fresh memory page-faults; CUDA has its caching allocator and streams)
         xy = (None if geometry is not None or textured or sunny or (not iso and not ratio) or cg.requires_grad
               or device.type != "cpu" else cg.separable_xy(sl))
         if xy is not None:
-            c1 = (inv_eps[sl] if cg.flat else cg.k_r[sl].to(dtype) * inv_eps[sl])[:, None, None]
-            sh = cg.s_h[sl, None, None] if not cg.flat else torch.zeros_like(c1)
-            az = None if iso else dict(offset=offset, fold=fold,
-                                       k=(2.0 / ((u_b - u_a) * (1.0 + ep))).to(dtype)[:, None, None],
-                                       b=((-2.0 * u_a / (u_b - u_a) - 1.0) / (1.0 + ep)).to(dtype)[:, None, None])
-            per_image = [c1, sh, k_sea, b_sea, k_sky, b_sky] + ([] if az is None else [az["offset"], az["k"], az["b"]])
+            per_image = [c1, sh, k_sea, b_sea, k_sky, b_sky] + ([] if iso else [offset, k_az, b_az])
             if torch.is_grad_enabled() and any(t.requires_grad for t in per_image):
                 xy = None  # a gradient through the per-image maps (e.g. wind_direction): the general path
         if xy is not None:
-            grid, seaf = table_grid(cg, sl, xy, c1, sh, (k_sea, b_sea), (k_sky, b_sky) if has_sky else None, az,
+            az_map = None if iso else dict(offset=offset, fold=fold, k=k_az, b=b_az)
+            grid, seaf = table_grid(cg, sl, xy, c1, sh, (k_sea, b_sea), (k_sky, b_sky) if has_sky else None, az_map,
                                     fresh_grid=torch.is_grad_enabled() and fine.requires_grad)
             vals = F.grid_sample(fine, grid, mode="bilinear", padding_mode="border", align_corners=True)[:, 0]
             if vals.requires_grad or len(chunks) == 1:
@@ -1553,8 +1556,6 @@ def _render_table(
             cos, dx, dy = cg.ray_components(sl, need_xy=not (iso or ratio) or sunny)
             if ratio:  # the table's azimuth coordinate from components along axes turned by the offset
                 c_t, s_t = cg.ray_components(sl, azimuth_offset=offset)
-            c1 = (inv_eps[sl] if cg.flat else cg.k_r[sl].to(dtype) * inv_eps[sl])[:, None, None]
-            sh = cg.s_h[sl, None, None] if not cg.flat else torch.zeros_like(c1)
             # q = (cos θ̂/ε)² = c1² (dz² − s_h²); sky pixels (unused) and the horizon row are held at
             # a tiny q > 0, which keeps √'s gradient finite
             # the sea mask as 1/0 in the image dtype, written by the compare (a bool → float copy costs
@@ -1571,14 +1572,7 @@ def _render_table(
         if iso:
             gx = torch.zeros_like(gy)
         else:
-            if ratio:
-                k_az = (2.0 / ((u_b - u_a) * (1.0 + ep))).to(dtype)[:, None, None]
-                b_az = ((-2.0 * u_a / (u_b - u_a) - 1.0) / (1.0 + ep)).to(dtype)[:, None, None]
-                az = _azimuth_ratio(c_t, s_t, fold)
-            else:
-                k_az = (2.0 / ((b - a) * (1.0 + ep))).to(dtype)[:, None, None]
-                b_az = ((-2.0 * a / (b - a) - 1.0) / (1.0 + ep)).to(dtype)[:, None, None]
-                az = _azimuth_coordinate(dx, dy, offset, fold)
+            az = _azimuth_ratio(c_t, s_t, fold) if ratio else _azimuth_coordinate(dx, dy, offset, fold)
             gx = torch.addcmul(b_az, az, k_az)
         # bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges
         # only to first order; bilinear on the fine table is second order (~3e-7 at 3072 rows).
@@ -1607,7 +1601,7 @@ def _render_table(
             vals = vals + texture
             resolved = (x_pix, cov_pix)
         if r_vals is not None:
-            vals = vals + r_vals * _glint_sharp_pixels(scene, p, sl, cos_t, dx, dy, sea)
+            vals = vals + r_vals * _glint_sharp_pixels(scene, p, sl, cos_t, dx, dy, sea & glint_tab[:, None, None])
         if sunny and (glint_tab is None or not bool(glint_tab.all())):  # the rest per pixel
             rows = None
             if scene.path is not None:  # each pixel's fractional sea row of the fine table

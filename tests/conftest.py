@@ -123,3 +123,13 @@ def smooth_sky(c: Any) -> Any:
 
 
 DEG = math.pi / 180.0
+
+
+@pytest.fixture(scope="module")
+def one_torch_thread():
+    """One torch thread for a module of small calls (~1e4 points): on a busy 2-core machine torch's
+    intra-op threads turn milliseconds into seconds. Use with ``pytest.mark.usefixtures``."""
+    n = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(n)

@@ -43,15 +43,7 @@ T = _table()
 NAMES = [str(n) for n in T["atmospheres"]]
 AEROSOLS = [str(n) for n in T["aerosols"]]
 COMBOS = [(n, a) for n in NAMES for a in AEROSOLS]
-
-
-@pytest.fixture(scope="module", autouse=True)
-def one_thread():
-    # small calls on a busy 2-core machine: torch's intra-op threads only add overhead
-    n = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 _SKIES: dict = {}

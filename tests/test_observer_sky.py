@@ -33,22 +33,13 @@ HELD_OUT_NEAR_LEVEL = 3e-2  # cells within 10 m of a LOWTRAN level (LOWTRAN's ow
 DIP_TABLE = {"subarctic_winter": 2e-2}
 DIP_TABLE_DEFAULT = 4e-3
 
-pytestmark = pytest.mark.skipif(not NAMES, reason="no observer-sky tables")
+pytestmark = [pytest.mark.skipif(not NAMES, reason="no observer-sky tables"),
+              pytest.mark.usefixtures("one_torch_thread")]
 
 
 def sin_dip(h):
     h = torch.as_tensor(h, dtype=F64)
     return torch.sqrt(h * (2 * atm.EARTH_RADIUS_M + h)) / (atm.EARTH_RADIUS_M + h)
-
-
-@pytest.fixture(scope="module", autouse=True)
-def one_thread():
-    # the calls here are small (~1e4 points); on a busy 2-core machine torch's intra-op threads
-    # turn milliseconds into seconds
-    n = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n)
 
 
 @pytest.fixture(scope="module")
