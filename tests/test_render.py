@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import threading
 
 import pytest
 import torch
@@ -478,3 +479,24 @@ def test_wind_direction_gradient_through_the_table_coordinates():
         h[i] = 1e-4
         fd = ((image(wd0 + h) - image(wd0 - h)) * weights).sum() / 2e-4
         assert abs(float(grad[i]) - float(fd)) <= 5e-3 * abs(float(fd)) + 1e-9, (i, float(grad[i]), float(fd))
+
+
+def test_workspace_of_an_ended_thread_is_dropped():
+    """A thread that rendered and ended leaves no workspace behind once another thread allocates one
+    (roughsea_torch._pixels keys them by thread; the planes of ended threads were kept)."""
+    from roughsea_torch import _pixels
+
+    scene = rs.SeaScene(wind_speed=6.0, sea_temperature=290.0, sky=sky)
+    rs.release_workspace()
+    before = torch.get_num_threads()
+    torch.set_num_threads(1)  # the render runs on the calling thread
+    try:
+        t = threading.Thread(target=lambda: rs.render(rs.make_camera(16, 20, altitude_m=20.0, pitch_deg=-5.0), scene))
+        t.start()
+        t.join()
+        assert t.ident in _pixels._spaces
+        rs.render(rs.make_camera(12, 16, altitude_m=20.0, pitch_deg=-5.0), scene)
+        assert t.ident not in _pixels._spaces and threading.get_ident() in _pixels._spaces
+    finally:
+        torch.set_num_threads(before)
+        rs.release_workspace()
