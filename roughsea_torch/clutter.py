@@ -267,11 +267,12 @@ class TextureTable:
         self.centres = cg.centres.to(dtype)
         self.time = per_batch("time_s", scene.time_s, B, dtype, device)
         self.quadrature = tuple(int(v) for v in table.texture_quadrature)
+        self.min_band_share = float(table.texture_min_band_share)
         self._warned = False
 
     def field(self, sl: slice, p: dict) -> Any:
         """The wave field of images ``sl``."""
-        return self.scene.wave_field(self.B, self.dtype, self.device, sl)
+        return self.scene.wave_field(self.B, self.dtype, self.device, sl, self.min_band_share)
 
     def resolved(self, wf: Any, L: torch.Tensor, p: dict, sl: slice) -> tuple[tuple[torch.Tensor, ...], torch.Tensor]:
         """The reconciled resolved covariance at footprints L (b, ...) and its scale λ (b, ...)."""

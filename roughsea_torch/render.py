@@ -348,20 +348,23 @@ class SeaScene:
             return [int(self.seed)]
         return [int(np.random.SeedSequence((int(self.seed), i)).generate_state(1, np.uint64)[0] >> 1) for i in range(B)]
 
-    def wave_field(self, B: int, dtype: torch.dtype, device: torch.device, sl: slice = slice(None)) -> Any:
-        """The :class:`~roughsea_torch.waves.WaveField` of images ``sl`` (textured scenes only).
-        The last one is kept while the scene's wind, direction and seed are unchanged (its random
+    def wave_field(self, B: int, dtype: torch.dtype, device: torch.device, sl: slice = slice(None),
+                   min_band_share: float | None = None) -> Any:
+        """The :class:`~roughsea_torch.waves.WaveField` of images ``sl`` (textured scenes only),
+        without the bands that carry less than ``min_band_share`` of an image's slope variance
+        (default ``TableSize.texture_min_band_share``, 1e-8). The last one is kept while the scene's wind, direction and seed are unchanged (its random
         amplitudes are drawn once)."""
         from .waves import WaveField
 
         wind = per_batch("wind_speed", self.wind_speed, B, dtype, device)[sl]
         wd = per_batch("wind_direction", self.wind_direction, B, dtype, device)[sl]
         seeds = self.seeds(B)[sl]
+        share = TableSize.texture_min_band_share if min_band_share is None else float(min_band_share)
         key = (tuple(seeds), tuple(wind.detach().cpu().tolist()), tuple(wd.detach().cpu().tolist()), dtype, str(device),
-               wind.requires_grad or wd.requires_grad)
+               share, wind.requires_grad or wd.requires_grad)
         wf = self._wave_fields.get(key)
         if wf is None or key[-1]:
-            wf = WaveField(wind, seeds, wind_direction=wd, dtype=dtype, device=device)
+            wf = WaveField(wind, seeds, wind_direction=wd, dtype=dtype, device=device, min_band_share=share)
             if not key[-1]:
                 if len(self._wave_fields) >= 8:
                     self._wave_fields.pop(next(iter(self._wave_fields)))
@@ -500,6 +503,14 @@ class TableSize:
             (x, ζ, azimuth) read by one trilinear ``grid_sample`` per sea pixel.
         texture_quadrature: (outer, inner) Gauss–Legendre nodes of the model at the texture nodes
             (the departure from the mean is the difference of two evaluations on this rule).
+        texture_min_band_share: per image, the octaves of the wave field that carry less than this
+            share of its slope variance (and of its crest variable's) are left out of the
+            realization, their variance left to the unresolved statistics (``WaveField(...,
+            min_band_share=)``): on the spectrum's low-k flank far below the peak of a light wind.
+            1e-8 skips a fifth of the band lookups of the README's batch; it moves a realization by
+            up to 3e-5 of the radiance, in the rows at the horizon, where a footprint resolves only
+            the longest waves and the radiance is most sensitive to slope (1e-6 would skip 29 % and
+            move it by 1e-4). 0 keeps every band.
 
     The defaults: 17 zenith nodes are as accurate as 21 (``pipelines/accuracy_pareto.py``, renderer
     panel: 1.2e-6 against per-pixel evaluation over 9276 cases, W 2–40 m/s); 3072 fine rows keep the
@@ -523,6 +534,7 @@ class TableSize:
     fine_texture_zenith: int = 512
     fine_texture_azimuth: int = 16
     texture_quadrature: tuple = (20, 16)
+    texture_min_band_share: float = 1e-8
     zenith_narrow: int = 21
     azimuth_day: int = 25
     glint: int = 33
@@ -539,6 +551,9 @@ class TableSize:
                      "fine_texture_zenith", "fine_texture_azimuth"):
             if int(getattr(self, name)) < 4 * _EXT + 2:
                 raise ValueError(f"TableSize.{name} must be >= {4 * _EXT + 2}")
+        share = self.texture_min_band_share
+        if isinstance(share, bool) or not isinstance(share, (int, float)) or not 0.0 <= float(share) < 1.0:
+            raise ValueError(f"TableSize.texture_min_band_share must be a number in [0, 1); got {share!r}")
 
 
 _EXT = 2  # fine cells beyond each end of the node interval, so no pixel reads the clamped border

@@ -343,6 +343,7 @@ class WaveBands:
 _WIN_LO = 1.0 / math.sqrt(2.0)  # u = k_o f / π below which a band is fully resolved (w = 1)
 _WIN_HI = math.sqrt(2.0)  # u above which it is fully unresolved (w = 0)
 _CHUNK_ELEMENTS = 2**18  # point-evaluations per chunk in WaveField.sample
+_BLOCK = 512  # points per block of the footprint's range (WaveField._sample_points)
 
 
 def _window(footprint: torch.Tensor, k_centre: float) -> torch.Tensor:
@@ -370,6 +371,15 @@ class WaveField:
         dtype: torch.float32 or torch.float64, the dtype of tiles and outputs.
         device: the device of tiles and outputs; default the device of the tensor arguments, else CPU.
         bands: a :class:`WaveBands` layout (default: 16 octaves, 2.45 cm … 1.6 km).
+        min_band_share: leave out the bands (per image) that carry less than this share of the
+            image's slope variance and less than this share of its crest variable's variance,
+            in [0, 1); default 0 (every band). Left-out bands have zero amplitudes, so every
+            statistic (:meth:`band_covariance`, :meth:`resolved_covariance`, the variances) is
+            that of the field without them, and :meth:`sample` skips them. The renderer uses
+            1e-6 (``SeaScene.wave_field``): on the spectrum's low-k flank, far below the peak of a
+            light wind, whole octaves carry 1e-10 to 1e-7 of the slope variance (their slope
+            amplitude 1e-5 to 3e-4 of the field's); they still carry elevation, which the
+            renderer does not use.
 
     Synthesis (Tessendorf 2001, with two changes that make the result exact and one-way):
         For band o on its tile (length L_o, N × N texels, lattice k = Δk_o (i, j)), every mode of
@@ -488,7 +498,10 @@ class WaveField:
         dtype: torch.dtype = torch.float32,
         device: torch.device | str | None = None,
         bands: WaveBands | None = None,
+        min_band_share: float = 0.0,
     ):
+        if not (isinstance(min_band_share, (int, float)) and 0.0 <= float(min_band_share) < 1.0):
+            raise ValueError(f"min_band_share must be a number in [0, 1); got {min_band_share!r}")
         if dtype not in (torch.float32, torch.float64):
             raise ValueError(f"dtype must be torch.float32 or torch.float64; got {dtype}")
         if bands is None:
@@ -531,6 +544,21 @@ class WaveField:
             signs.append(sgn)
             gains.append(gain)
             variances.append(var)
+        # bands below min_band_share of the image's slope variance and of its crest variable's are
+        # left out (zero amplitudes, covariance and variances: sample skips them)
+        cov64, var64 = torch.stack(covariances), torch.stack(variances)  # (B, n_bands, 3), (B, n_bands, 2)
+        slope = cov64[..., 0] + cov64[..., 1]
+        crest = var64[..., 1]
+        share = torch.maximum(slope / slope.sum(-1, keepdim=True).clamp_min(1e-300),
+                              crest / crest.sum(-1, keepdim=True).clamp_min(1e-300))
+        on = share.detach() >= float(min_band_share)
+        self._band_on = on.cpu()  # (B, n_bands) bool
+        if not bool(on.all()):
+            keep = on.to(torch.float64)
+            amplitudes = [a * keep[b, :, None, None].to(a.device) for b, a in enumerate(amplitudes)]
+            covariances = [c * keep[b, :, None].to(c.device) for b, c in enumerate(covariances)]
+            variances = [v * keep[b, :, None].to(v.device) for b, v in enumerate(variances)]
+        self.min_band_share = float(min_band_share)
         cdt = torch.complex64 if dtype == torch.float32 else torch.complex128
         self._h0 = [a.to(cdt) for a in amplitudes]  # per image (n_bands, 2M+1, M+1) complex
         self._sign = signs  # per image (n_bands, 2M+1, M+1) float64 ±1 (0 outside the bands)
@@ -820,53 +848,81 @@ class WaveField:
                 raise ValueError(f"footprint: shape {tuple(f.shape)} does not broadcast to x {tuple(shape)}") from err
 
         tiles = self._tiles(t_s, elevation, crest)
-        # points are processed in chunks of about 2**18 point-evaluations: the temporaries stay in
-        # cache and in the allocator's heap (large tensors are mmapped afresh on every op), which
-        # makes the elementwise work 2-3x faster on a CPU. Chunking is along the points only, and
-        # every per-point operation is the same whatever the chunk, so results do not depend on it.
-        chunk = max(1024, _CHUNK_ELEMENTS // batch)
-        pieces = [
-            self._sample_points(tiles, xy[:, a : a + chunk], None if f is None else f[:, a : a + chunk])
-            for a in range(0, npts, chunk)
-        ]
-        acc = pieces[0] if len(pieces) == 1 else torch.cat(pieces, dim=-1)
-        out = {}
-        for c, name in enumerate(names):
-            out[name] = acc[:, c].reshape(shape)
-        return out
+        acc = self._sample_points(tiles, xy, f)
+        return {name: acc[:, c].reshape(shape) for c, name in enumerate(names)}
 
     def _sample_points(self, tiles: torch.Tensor, xy: torch.Tensor, f: torch.Tensor | None) -> torch.Tensor:
-        """Σ_o w_o · bilinear(tile_o) at points xy (B, P, 2) → (B, C, P)."""
+        """Σ_o w_o · bilinear(tile_o) at points xy (B, P, 2) → (B, C, P).
+
+        Band by band, then chunk by chunk of about 2**18 point-evaluations (the temporaries stay in
+        cache). Each band's tile is doubled to 2N + 1 texels per side (the period twice, circularly)
+        so that its grid is ``frac(x / L_o)`` ∈ (−1, 1) straight away: ``frac`` costs a quarter of
+        the floor-division ``remainder``. Points beyond a band's window (w = 0) are not evaluated,
+        and the window multiplies only the points where it is below 1: both found from the
+        footprint's minimum and maximum over blocks of points, so the skipped work would have
+        added exactly 0 or multiplied by exactly 1 (results do not depend on chunks or blocks). A
+        band whose tile is zero for every image (``min_band_share``) is skipped."""
         batch, npts = xy.shape[0], xy.shape[1]
+        n_ch = tiles.shape[2]
         acc = None
+        chunk = max(1024, _CHUNK_ELEMENTS // batch)
         f_all = None if f is None else f.detach()
+        if f_all is not None:  # per block of points: the footprint's least and largest value over the batch
+            nblk = -(-npts // _BLOCK)
+            pad = nblk * _BLOCK - npts
+            fb = f_all if pad == 0 else torch.cat([f_all, f_all[:, -1:].expand(batch, pad)], 1)
+            fb = fb.reshape(batch, nblk, _BLOCK)
+            f_min, f_max = fb.amin(dim=(0, 2)), fb.amax(dim=(0, 2))
         margin = 1e-3  # the tensor window is exactly 0 (or 1) well inside these bounds
+        n = tiles.shape[-1] - 1
         for o, (k_o, length) in enumerate(zip(self.bands.band_wavenumber, self.bands.tile_length)):
-            lo, hi = 0, npts
+            if not self._band_on[:, o].any():
+                continue
+            runs, part = [(0, npts)], None
             if f_all is not None:
-                # points beyond the window's support have w = 0 exactly; evaluate the band only on
-                # the smallest contiguous range of points holding every point with w > 0 in any
-                # image. Skipped points would add exactly 0, so the result is bitwise the same.
-                active = (f_all < _WIN_HI * (1.0 + margin) * math.pi / k_o).any(dim=0)
-                where = torch.nonzero(active)
-                if where.numel() == 0:
+                runs = _runs((f_min < _WIN_HI * (1.0 + margin) * math.pi / k_o).cpu().numpy(), npts)
+                if not runs:
                     continue
-                lo, hi = int(where[0]), int(where[-1]) + 1
-            grid = torch.remainder(xy[:, lo:hi] * (2.0 / length), 2.0) - 1.0
-            values = F_nn.grid_sample(
-                tiles[o], grid.unsqueeze(1), mode="bilinear", padding_mode="border", align_corners=True
-            ).squeeze(2)  # (B, C, P')
-            if f is not None and not float(f_all[:, lo:hi].max()) * k_o / math.pi <= _WIN_LO * (1.0 - margin):
-                values = values * _window(f[:, lo:hi], k_o).unsqueeze(1)  # else w = 1 exactly
-            if acc is None and lo == 0 and hi == npts:
-                acc = values
-            else:
-                if acc is None:
-                    acc = torch.zeros((batch, tiles.shape[2], npts), dtype=self.dtype, device=self.device)
-                acc[..., lo:hi] += values  # in place on our own buffer; autograd records the slice
+                part = (f_max > _WIN_LO * (1.0 - margin) * math.pi / k_o).cpu().numpy()  # blocks where w may be < 1
+            # the tile doubled: the period twice, plus texel 2N = texel 0 (circular pad)
+            tile = F_nn.pad(tiles[o][..., :n, :n].repeat(1, 1, 2, 2), (0, 1, 0, 1), mode="circular")
+            for lo, hi in runs:
+                for a in range(lo, hi, chunk):
+                    e = min(hi, a + chunk)
+                    grid = xy[:, a:e] * (1.0 / length)
+                    grid = torch.frac(grid) if grid.requires_grad else torch.frac(grid, out=grid)
+                    values = F_nn.grid_sample(tile, grid.unsqueeze(1), mode="bilinear", padding_mode="border",
+                                              align_corners=True).squeeze(2)  # (B, C, P')
+                    if part is not None:
+                        a0 = a // _BLOCK * _BLOCK
+                        w_runs = _runs(part[a // _BLOCK : -(-e // _BLOCK)], e - a0, a0)
+                        if w_runs:  # the window where it may be below 1 (exactly 1 elsewhere), one span
+                            u, v = max(a, w_runs[0][0]), min(e, w_runs[-1][1])
+                            w = _window(f[:, u:v], k_o).unsqueeze(1)
+                            if values.requires_grad or w.requires_grad:
+                                values = torch.cat([values[..., : u - a], values[..., u - a : v - a] * w,
+                                                    values[..., v - a :]], -1)
+                            else:
+                                values[..., u - a : v - a] *= w
+                    if acc is None:
+                        acc = torch.zeros((batch, n_ch, npts), dtype=self.dtype, device=self.device)
+                    acc[..., a:e] += values  # in place on our own buffer; autograd records the slice
         if acc is None:
-            acc = torch.zeros((batch, tiles.shape[2], npts), dtype=self.dtype, device=self.device)
+            acc = torch.zeros((batch, n_ch, npts), dtype=self.dtype, device=self.device)
         return acc
+
+
+def _runs(blocks: np.ndarray, npts: int, offset: int = 0, gap: int = 4) -> list[tuple[int, int]]:
+    """Point ranges [a, b) covering the True blocks of ``blocks`` (blocks of ``_BLOCK`` points from
+    point ``offset``), runs less than ``gap`` blocks apart merged (fewer, larger calls), clipped to
+    ``offset + npts``."""
+    on = np.flatnonzero(blocks)
+    if on.size == 0:
+        return []
+    cut = np.flatnonzero(np.diff(on) > gap)
+    starts = np.concatenate([on[:1], on[cut + 1]])
+    ends = np.concatenate([on[cut], on[-1:]]) + 1
+    return [(offset + int(a) * _BLOCK, min(offset + npts, offset + int(b) * _BLOCK)) for a, b in zip(starts, ends)]
 
 
 # ---------------------------------------------------------------------------------------------

@@ -239,6 +239,73 @@ def test_footprint_none_equals_zero_footprint():
         assert torch.equal(a[key], b[key])
 
 
+def test_sample_is_pointwise_whatever_the_order_and_the_skipped_blocks():
+    """sample evaluates a band only on runs of blocks of points whose footprint reaches it, and
+    windows only the blocks where w may be below 1; each point's value must not depend on which
+    other points share its blocks. Points whose footprints mix 0 (every band, w = 1), inf (none)
+    and values across the bands' windows, in runs and shuffled: the shuffled sample is the sample
+    shuffled (bitwise), inf gives exactly 0, 0 gives the sample without footprint, and a point
+    evaluated alone gives its value in the batch."""
+    gen = torch.Generator().manual_seed(5)
+    field = WaveField(torch.tensor([4.0, 12.0]), [8, 9], wind_direction=torch.tensor([0.3, -1.0]), dtype=torch.float64)
+    n = 20_000
+    x = (torch.rand(2, n, generator=gen, dtype=torch.float64) - 0.5) * 3000
+    y = (torch.rand(2, n, generator=gen, dtype=torch.float64) - 0.5) * 3000
+    f = torch.exp(torch.rand(2, n, generator=gen, dtype=torch.float64) * 14 - 8)  # 0.3 mm ... 400 m
+    f[:, 3000:5000] = 0.0
+    f[:, 9000:12000] = math.inf
+    f[:, 15000:15500] = 1e-3  # a run where only the footprint's own window applies
+    perm = torch.randperm(n, generator=gen)
+    a = field.sample(x, y, 2.0, footprint=f, crest=True)
+    b = field.sample(x[:, perm], y[:, perm], 2.0, footprint=f[:, perm], crest=True)
+    none = field.sample(x[:, 3000:5000], y[:, 3000:5000], 2.0, crest=True)
+    for key in a:
+        assert torch.equal(a[key][:, perm], b[key]), key
+        assert torch.equal(a[key][:, 9000:12000], torch.zeros(2, 3000, dtype=torch.float64)), key
+        assert torch.equal(a[key][:, 3000:5000], none[key]), key
+    for i in (17, 7000, 15100, 19999):
+        one = field.sample(x[:, i : i + 1], y[:, i : i + 1], 2.0, footprint=f[:, i : i + 1], crest=True)
+        for key in a:
+            assert torch.allclose(one[key], a[key][:, i : i + 1], rtol=1e-13, atol=1e-15), (key, i)
+
+
+def test_min_band_share_leaves_out_the_weak_bands_and_only_them():
+    """WaveField(min_band_share=s) drops, per image, the bands that carry less than s of the image's
+    slope variance and of its crest variable's (shares computed here from the full field), and
+    nothing else: their covariance and variances are 0, the others' unchanged, and the sample is the
+    full field's minus those bands' contribution (the full field's sample at the footprint where its
+    window keeps exactly those bands, 1/√2 π/k of the last one)."""
+    wind = torch.tensor([3.0, 20.0], dtype=torch.float64)
+    full = WaveField(wind, [1, 2], dtype=torch.float64)
+    part = WaveField(wind, [1, 2], dtype=torch.float64, min_band_share=1e-6)
+    cov = full.band_covariance()
+    slope = cov[..., 0] + cov[..., 1]
+    crest = full.band_crest_variance()
+    weak = (slope / slope.sum(-1, keepdim=True) < 1e-6) & (crest / crest.sum(-1, keepdim=True) < 1e-6)
+    assert bool(weak[0, :2].all()) and not bool(weak[0].all())  # 3 m/s: the lowest bands go
+    assert torch.equal(part.band_covariance()[weak], torch.zeros_like(cov[weak]))
+    assert torch.equal(part.band_covariance()[~weak], cov[~weak])
+    assert torch.equal(part.band_crest_variance()[~weak], crest[~weak])
+    assert torch.equal(part.band_elevation_variance()[weak], torch.zeros_like(crest[weak]))
+    gen = torch.Generator().manual_seed(2)
+    x = (torch.rand(1, 5000, generator=gen, dtype=torch.float64) - 0.5) * 5000
+    y = (torch.rand(1, 5000, generator=gen, dtype=torch.float64) - 0.5) * 5000
+    last = int(torch.nonzero(weak[0])[-1])
+    assert bool(weak[0, : last + 1].all())  # a prefix: the spectrum's low-k flank
+    f_weak = (1.0 / math.sqrt(2.0)) * math.pi / full.bands.band_wavenumber[last]
+    one = lambda fld, **k: {key: v[:1] for key, v in fld.sample(x.expand(2, -1), y.expand(2, -1), 4.0, crest=True, **k).items()}  # noqa: E731
+    a, b = one(full), one(part)
+    low = one(full, footprint=torch.full((2, 5000), f_weak, dtype=torch.float64))
+    for key in a:
+        scale = float(a[key].abs().max())
+        assert float((a[key] - low[key] - b[key]).abs().max()) < 1e-9 * scale, key
+        assert float((a[key] - b[key]).abs().max()) > 0.0, key  # the dropped bands were not zero
+    with pytest.raises(ValueError, match=r"min_band_share must be a number in \[0, 1\)"):
+        WaveField(5.0, 0, min_band_share=1.0)
+    with pytest.raises(ValueError, match=r"min_band_share must be a number in \[0, 1\)"):
+        WaveField(5.0, 0, min_band_share=-1e-9)
+
+
 def test_band_weights_window():
     """band_weights: 1 at f = 0, 0 at f = inf, monotone and C¹ in log f, one octave wide around
     k_o f = π (1 below 0.707 π, 0 above 1.414 π), finite gradients (also at inf)."""
