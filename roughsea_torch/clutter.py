@@ -240,8 +240,8 @@ class TextureTable:
     Per image, the realization's departure from the expectation, Δ(ζ, o, x) = R(a'(x)) − R_a, at
     Chebyshev–Lobatto nodes in ζ (its own), azimuth o (the mean table's) and the flat-point
     quantile x of the resolved along-view slope; resampled spectrally to a fine volume (x, ζ, o)
-    times the path transmittance τ(ζ) of each row, read per sea pixel by one trilinear
-    ``grid_sample``. The nodes' footprint, resolved covariance and unresolved Gaussian follow the
+    times the path transmittance τ(ζ) of each row, read per sea pixel trilinearly (two bilinear
+    ``grid_sample`` of the two slices of x about the pixel, and a lerp). The nodes' footprint, resolved covariance and unresolved Gaussian follow the
     node's (θ̂, φ̂) and the camera's range at θ̂ (for one camera the range is a function of θ̂);
     nodes where nothing is resolved (far field) are not evaluated and hold Δ = 0.
     """
@@ -293,8 +293,8 @@ class TextureTable:
     def node_delta(self, sl: slice, p: dict, wf: Any, ph_nodes: torch.Tensor, sky: Any, scene: Any, q: Any,
                    altitude: torch.Tensor, earth_radius_m: float, eps: torch.Tensor, lo: torch.Tensor,
                    span_z: torch.Tensor) -> torch.Tensor | None:
-        """The fine texture volume (b, C, fine_texture, fine_texture_zenith, fine_texture_azimuth), τ
-        included, C = 1, or 2 with a sun (channel 1: the visible quantile x' = a'/σ_a that the glint's
+        """The fine texture volume, τ included, laid out (b, C, fine_texture_zenith, fine_texture ·
+        fine_texture_azimuth) (the slices of x side by side), C = 1, or 2 with a sun (channel 1: the visible quantile x' = a'/σ_a that the glint's
         unresolved Gaussian is centred on, read per pixel instead of inverting :func:`visible_slope`'s
         distribution at every pixel); None when no node of the chunk resolves any wave."""
         from .expectation import _reflection_terms
@@ -358,15 +358,17 @@ class TextureTable:
             delta = torch.stack([delta, xv], 1)
         else:
             delta = delta[:, None]
-        vol = torch.einsum("rz,bczpx,ap,fx->bcfra", self.Lz, delta, self.La, self.Lx)
+        # laid out (b, C, ζ, x, azimuth) and flattened to (b, C, ζ, x · azimuth): the slices of x side
+        # by side along the width, read by two bilinear lookups and a lerp (see pixels)
+        vol = torch.einsum("rz,bczpx,ap,fx->bcrfa", self.Lz, delta, self.La, self.Lx)
         if scene.path is not None:
             Mt = self.Lz.shape[0]
             y = torch.linspace(-1.0 - self.ez, 1.0 + self.ez, Mt, dtype=torch.float64, device=device)
             cos_rows = (eps[:, None] * torch.sinh(lo[:, None] + span_z[:, None] * (y + 1) / 2)).clamp(0.0, 1.0).to(dtype)
             tau, _ = scene.path(h[:, None].expand_as(cos_rows), _slant_range(cos_rows, h[:, None], earth_radius_m),
                                 clamp=True)
-            vol = torch.cat([vol[:, :1] * tau.to(dtype)[:, None, None, :, None], vol[:, 1:]], 1)
-        return vol
+            vol = torch.cat([vol[:, :1] * tau.to(dtype)[:, None, :, None, None], vol[:, 1:]], 1)
+        return vol.flatten(-2)
 
     def pixels(self, sl: slice, p: dict, wf: Any, vol: torch.Tensor, cos_t: torch.Tensor,
                zeta: torch.Tensor, o: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, sea: torch.Tensor,
@@ -406,11 +408,20 @@ class TextureTable:
         grid = torch.stack([torch.zeros_like(gy), gy], -1)
         cov = F.grid_sample(cov_rows, grid, mode="bilinear", padding_mode="border", align_corners=True)
         x, _, _ = pixel_resolved_slope(smp["slope_x"], smp["slope_y"], (cov[:, 0], cov[:, 1], cov[:, 2]), dx, dy)
-        gz = x / (self.width * (1.0 + self.ex))
+        # trilinear in (x, ζ, azimuth) as two bilinear reads of the slices of x that hold the pixel
+        # (side by side along the width: column i · n_az + azimuth index) and a lerp between them;
+        # border values beyond each axis, as a 3-D grid_sample (whose CPU kernel costs ~3x more)
+        n_x, n_az = self.Lx.shape[0], self.La.shape[0]
         a_, b2 = a.to(dtype)[:, None, None], b.to(dtype)[:, None, None]
-        gx = (2.0 * (o - a_) / (b2 - a_) - 1.0) / (1.0 + self.ea)
-        grid = torch.stack([gx, gy, gz], -1)[:, None]  # (b, 1, H, W, 3): x → W (azimuth), y → H (ζ), z → D (x)
-        read = F.grid_sample(vol, grid, mode="bilinear", padding_mode="border", align_corners=True)[:, :, 0]
+        col = ((2.0 * (o - a_) / (b2 - a_) - 1.0) / (1.0 + self.ea)).clamp(-1.0, 1.0).add(1.0).mul((n_az - 1) / 2.0)
+        z = (x / (self.width * (1.0 + self.ex))).clamp(-1.0, 1.0).add(1.0).mul((n_x - 1) / 2.0)
+        i0 = torch.floor(z.detach()).clamp_(max=n_x - 2)
+        fz = z - i0
+        scale = 2.0 / (n_x * n_az - 1)
+        g0 = torch.addcmul(col, i0, torch.full_like(i0, float(n_az))).mul(scale).sub(1.0)
+        reads = [F.grid_sample(vol, torch.stack([gc, gy], 1).permute(0, 2, 3, 1), mode="bilinear", padding_mode="border",
+                               align_corners=True) for gc in (g0, g0 + n_az * scale)]
+        read = torch.lerp(reads[0], reads[1], fz[:, None])
         out = read[:, 0]
         # x (or, with a sun, the visible quantile x' read from channel 1) and the resolved covariance go
         # back too: the glint of the same realization needs them

@@ -381,6 +381,12 @@ def crest_foam_fraction(
     v_r = as_tensor(resolved_variance, dtype, device)
     v_t = as_tensor(total_variance, dtype, device)
     w = as_tensor(whitecap_fraction, dtype, device)
+    return _crest_foam_fraction(x, v_r, v_t, w, floor)
+
+
+def _crest_foam_fraction(x: torch.Tensor, v_r: torch.Tensor, v_t: torch.Tensor, w: torch.Tensor,
+                         floor: float = CREST_FOAM_FLOOR) -> torch.Tensor:
+    """:func:`crest_foam_fraction` on tensors already checked (the renderer's, per pixel)."""
     v_u = torch.clamp(v_t - v_r, min=0.0) + (floor * floor) * v_t
     known = v_u > 0  # False only without crest variance at all (or ρ = 0 and nothing unresolved)
     v_u = torch.where(known, v_u, torch.ones_like(v_u))

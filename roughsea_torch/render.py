@@ -500,7 +500,7 @@ class TableSize:
             pixel instead of inverted per pixel): an MWIR sea, sun 15° up ahead, against per-pixel
             evaluation: 3.8e-4 with 33 nodes, 4.8e-5 with 65 (``tests/test_sun.py``).
         fine_texture, fine_texture_zenith, fine_texture_azimuth: the fine texture volume
-            (x, ζ, azimuth) read by one trilinear ``grid_sample`` per sea pixel.
+            (x, ζ, azimuth) read trilinearly per sea pixel (two bilinear ``grid_sample`` and a lerp).
         texture_quadrature: (outer, inner) Gauss–Legendre nodes of the model at the texture nodes
             (the departure from the mean is the difference of two evaluations on this rule).
         texture_min_band_share: per image, the octaves of the wave field that carry less than this
@@ -1628,10 +1628,10 @@ def _render_table(
                 glint = glint * (1.0 - p["foam"][sl].to(dtype))[:, None, None]
             vals = vals + glint
         if crest:  # (1 − f_pix) · (sea + texture + glint) + f_pix · foam
-            from .foam import crest_foam_fraction
+            from .foam import _crest_foam_fraction
 
             x_r, v_r, v_t = crest_var[0]
-            f_pix = crest_foam_fraction(x_r, v_r, v_t, p["foam"][sl].to(dtype)[:, None, None])
+            f_pix = _crest_foam_fraction(x_r, v_r, v_t, p["foam"][sl].to(dtype)[:, None, None])
             vals = torch.lerp(vals, foam_vals, f_pix)
         if sunny and has_sky:  # the sun's disk itself, where it is in view
             ifov = (1.0 / cg.cameras.fx.to(dtype))[sl]
