@@ -393,7 +393,8 @@ class TextureTable:
         cen = self.centres[sl]
         X = cen[:, 0, None, None] + R * dx
         Y = cen[:, 1, None, None] + R * dy
-        smp = wf.sample(X, Y, self.time[sl], footprint=L, elevation=False, crest=crest)
+        # (the field's own entry without the input checks: X, Y, L come from the finite geometry)
+        smp = wf._sample(X, Y, self.time[sl].to(torch.float64), L, elevation=False, crest=crest)
         gy = (2.0 * (zeta - lo.to(dtype)[:, None, None]) / span_z.to(dtype)[:, None, None] - 1.0) / (1.0 + self.ez)
         # σ_a of each pixel from the resolved covariance of its row: for one camera the footprint is a
         # function of θ̂ alone, so the covariance is tabulated on the texture's rows and read

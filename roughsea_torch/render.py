@@ -642,8 +642,12 @@ def _azimuth_coordinate(dx: torch.Tensor, dy: torch.Tensor, offset: torch.Tensor
     ``fold`` (uncorrelated slopes, ``offset`` = π/2 − wind direction): ψ = |φ̂| folded into
     [0, π/2] by the mirror symmetries R_a(φ̂) = R_a(−φ̂) = R_a(π − φ̂); otherwise (``offset`` =
     π/2 − c − wind direction, c the image's centre azimuth): o = wrap_π(φ̂ − c) + π/2 ∈ [0, π)."""
-    # atan2(dy, dx) is the ray's azimuth, the LOS's + π: the same modulo π
-    o = torch.remainder(torch.atan2(dy, dx) + offset[:, None, None], math.pi)
+    # atan2(dy, dx) is the ray's azimuth, the LOS's + π: the same modulo π. With the offset wrapped
+    # into [0, π) per image, (atan2 + offset)/π + 1 lies in [0, 3): its frac is the remainder
+    # (torch.remainder, a floor division, costs ~4x frac on the CPU)
+    start = 1.0 + torch.remainder(offset, math.pi) / math.pi
+    o = torch.frac(torch.addcmul(start[:, None, None].to(dy.dtype), torch.atan2(dy, dx), torch.full_like(dy[:1, :1, :1], 1.0 / math.pi)))
+    o = o.mul_(math.pi) if not o.requires_grad else o * math.pi
     return (o - math.pi / 2).abs() if fold else o
 
 

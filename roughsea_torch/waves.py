@@ -832,21 +832,28 @@ class WaveField:
                 raise ValueError(f"{name} must be finite world coordinates [m] (no NaN or inf)")
         check_finite_range("time_s", time_s, -1e9, 1e9, unit="s")
         t_s = per_batch("time_s", time_s, self.batch_size, torch.float64, self.device)
+        f = None
+        if footprint is not None:
+            f = self._footprint_tensor(footprint)
+            try:
+                f = torch.broadcast_to(f, shape)
+            except RuntimeError as err:
+                raise ValueError(f"footprint: shape {tuple(f.shape)} does not broadcast to x {tuple(shape)}") from err
+        return self._sample(xt, yt, t_s, f, elevation, crest)
+
+    def _sample(self, xt: torch.Tensor, yt: torch.Tensor, t_s: torch.Tensor, f: torch.Tensor | None, elevation: bool,
+                crest: bool) -> dict[str, torch.Tensor]:
+        """:meth:`sample` on arguments already checked: x, y (B, ...) of the field's dtype, finite; times
+        (B,) float64; footprints of x's shape (≥ 0) or None."""
+        shape = xt.shape
         batch = self.batch_size
         npts = int(np.prod(shape[1:])) if len(shape) > 1 else 1
         names = (["elevation"] if elevation else []) + ["slope_x", "slope_y"] + (["crest"] if crest else [])
         if npts == 0:
             return {name: xt.new_zeros(shape) for name in names}
         xy = torch.stack((xt.reshape(batch, npts), yt.reshape(batch, npts)), dim=-1)  # (B, P, 2)
-
-        f = None
-        if footprint is not None:
-            f = self._footprint_tensor(footprint)
-            try:
-                f = torch.broadcast_to(f, shape).reshape(batch, npts)
-            except RuntimeError as err:
-                raise ValueError(f"footprint: shape {tuple(f.shape)} does not broadcast to x {tuple(shape)}") from err
-
+        if f is not None:
+            f = f.reshape(batch, npts)
         tiles = self._tiles(t_s, elevation, crest)
         acc = self._sample_points(tiles, xy, f)
         return {name: acc[:, c].reshape(shape) for c, name in enumerate(names)}
