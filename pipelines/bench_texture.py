@@ -58,7 +58,7 @@ def stages(cams, textured) -> list[tuple[str, float]]:
     import roughsea_torch.clutter as cl
 
     wrapped = {}
-    for name in ("node_delta", "pixels"):
+    for name in ("node_values", "volume", "pixels"):
         f = getattr(cl.TextureTable, name)
 
         def w(self, *a, _f=f, _n=name, **k):

@@ -290,13 +290,15 @@ class TextureTable:
             self._warned = True
         return tuple(c * lam * lam for c in cov), lam
 
-    def node_delta(self, sl: slice, p: dict, wf: Any, ph_nodes: torch.Tensor, sky: Any, scene: Any, q: Any,
-                   altitude: torch.Tensor, earth_radius_m: float, eps: torch.Tensor, lo: torch.Tensor,
-                   span_z: torch.Tensor) -> torch.Tensor | None:
-        """The fine texture volume, τ included, laid out (b, C, fine_texture_zenith, fine_texture ·
-        fine_texture_azimuth) (the slices of x side by side), C = 1, or 2 with a sun (channel 1: the visible quantile x' = a'/σ_a that the glint's
-        unresolved Gaussian is centred on, read per pixel instead of inverting :func:`visible_slope`'s
-        distribution at every pixel); None when no node of the chunk resolves any wave."""
+    def node_values(self, sl: slice, p: dict, wf: Any, ph_nodes: torch.Tensor, sky: Any, scene: Any, q: Any,
+                    altitude: torch.Tensor, earth_radius_m: float, eps: torch.Tensor, lo: torch.Tensor,
+                    span_z: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """The texture at its nodes for images ``sl``: (Δ, active), Δ (b, C, nz, nphi, nx), C = 1, or 2
+        with a sun (channel 1: the visible quantile x' = a'/σ_a that the glint's unresolved Gaussian
+        is centred on, read per pixel instead of inverting :func:`visible_slope`'s distribution at
+        every pixel), and active (b,) bool: whether any node of the image resolves a wave (Δ = 0
+        and x' = x where none does). Made of many small operations: the renderer runs it for
+        groups of images, then :meth:`volume` per chunk of pixels."""
         from .expectation import _reflection_terms
         from .render import _sky_per_image, _slant_range
         from .sky import TabulatedSky, select_sky
@@ -319,7 +321,10 @@ class TextureTable:
         suu = vx * c * c + 2.0 * cxy * c * s + vy * s * s
         active = (var_a > 1e-10 * suu).expand(b_, nz, nphi)
         if not bool(active.any()):
-            return None
+            zero = torch.zeros(b_, 1, nz, nphi, self.xnodes.numel(), dtype=dtype, device=device)
+            if scene.sun is not None:
+                zero = torch.cat([zero, self.xnodes.expand(b_, 1, nz, nphi, -1)], 1)
+            return zero, torch.zeros(b_, dtype=torch.bool, device=device)
         idx = active.nonzero(as_tuple=True)
         img = idx[0]
         full = lambda t: t.expand(b_, nz, nphi)[idx]  # noqa: E731
@@ -358,16 +363,31 @@ class TextureTable:
             delta = torch.stack([delta, xv], 1)
         else:
             delta = delta[:, None]
+        return delta, active.flatten(1).any(1)
+
+    def volume(self, delta: torch.Tensor, sl: slice, scene: Any, altitude: torch.Tensor, earth_radius_m: float,
+               eps: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor) -> torch.Tensor:
+        """The fine texture volume of images ``sl`` from their node values Δ (:meth:`node_values`), τ
+        included, laid out (b, C, fine_texture_zenith, fine_texture · fine_texture_azimuth) (the
+        slices of x side by side)."""
+        from .render import _slant_range
+
+        dtype, device = self.dtype, self.device
+        h = altitude[sl].to(dtype)
         # laid out (b, C, ζ, x, azimuth) and flattened to (b, C, ζ, x · azimuth): the slices of x side
         # by side along the width, read by two bilinear lookups and a lerp (see pixels)
-        vol = torch.einsum("rz,bczpx,ap,fx->bcrfa", self.Lz, delta, self.La, self.Lx)
+        vol = torch.einsum("rz,bczpx,ap,fx->bcrfa", self.Lz, delta, self.La, self.Lx).contiguous()
         if scene.path is not None:
             Mt = self.Lz.shape[0]
             y = torch.linspace(-1.0 - self.ez, 1.0 + self.ez, Mt, dtype=torch.float64, device=device)
             cos_rows = (eps[:, None] * torch.sinh(lo[:, None] + span_z[:, None] * (y + 1) / 2)).clamp(0.0, 1.0).to(dtype)
             tau, _ = scene.path(h[:, None].expand_as(cos_rows), _slant_range(cos_rows, h[:, None], earth_radius_m),
                                 clamp=True)
-            vol = torch.cat([vol[:, :1] * tau.to(dtype)[:, None, :, None, None], vol[:, 1:]], 1)
+            t_ = tau.to(dtype)[:, None, :, None, None]
+            if vol.requires_grad or t_.requires_grad:
+                vol = torch.cat([vol[:, :1] * t_, vol[:, 1:]], 1)
+            else:  # in place on the einsum's own output
+                vol[:, :1] *= t_
         return vol.flatten(-2)
 
     def pixels(self, sl: slice, p: dict, wf: Any, vol: torch.Tensor, cos_t: torch.Tensor,
@@ -419,10 +439,18 @@ class TextureTable:
         i0 = torch.floor(z.detach()).clamp_(max=n_x - 2)
         fz = z - i0
         scale = 2.0 / (n_x * n_az - 1)
-        g0 = torch.addcmul(col, i0, torch.full_like(i0, float(n_az))).mul(scale).sub(1.0)
-        reads = [F.grid_sample(vol, torch.stack([gc, gy], 1).permute(0, 2, 3, 1), mode="bilinear", padding_mode="border",
-                               align_corners=True) for gc in (g0, g0 + n_az * scale)]
-        read = torch.lerp(reads[0], reads[1], fz[:, None])
+        g0 = (i0 * float(n_az)).add_(col).mul_(scale).sub_(1.0)
+        del col, z
+        grid = torch.stack([g0, gy], 1)
+        read = F.grid_sample(vol, grid.permute(0, 2, 3, 1), mode="bilinear", padding_mode="border", align_corners=True)
+        if grid.requires_grad:  # (grid_sample keeps its grid for the backward pass)
+            grid = torch.stack([g0 + n_az * scale, gy], 1)
+        else:
+            grid[:, 0] += n_az * scale  # the next slice of x, one block of columns to the right
+        upper = F.grid_sample(vol, grid.permute(0, 2, 3, 1), mode="bilinear", padding_mode="border", align_corners=True)
+        del grid
+        read = torch.lerp(read, upper, fz[:, None]) if read.requires_grad or fz.requires_grad else read.lerp_(upper, fz[:, None])
+        del upper
         out = read[:, 0]
         # x (or, with a sun, the visible quantile x' read from channel 1) and the resolved covariance go
         # back too: the glint of the same realization needs them

@@ -352,8 +352,9 @@ class SeaScene:
                    min_band_share: float | None = None) -> Any:
         """The :class:`~roughsea_torch.waves.WaveField` of images ``sl`` (textured scenes only),
         without the bands that carry less than ``min_band_share`` of an image's slope variance
-        (default ``TableSize.texture_min_band_share``, 1e-8). The last one is kept while the scene's wind, direction and seed are unchanged (its random
-        amplitudes are drawn once)."""
+        (default ``TableSize.texture_min_band_share``, 1e-8). The last 64 (per group of images the
+        renderer asks for) are kept while the scene's wind, direction and seed are unchanged (their
+        random amplitudes are drawn once)."""
         from .waves import WaveField
 
         wind = per_batch("wind_speed", self.wind_speed, B, dtype, device)[sl]
@@ -366,7 +367,7 @@ class SeaScene:
         if wf is None or key[-1]:
             wf = WaveField(wind, seeds, wind_direction=wd, dtype=dtype, device=device, min_band_share=share)
             if not key[-1]:
-                if len(self._wave_fields) >= 8:
+                if len(self._wave_fields) >= 64:
                     self._wave_fields.pop(next(iter(self._wave_fields)))
                 self._wave_fields[key] = wf
         return wf
@@ -724,6 +725,39 @@ class _Ranges:
     any_sky: torch.Tensor
     azimuth: tuple[torch.Tensor, torch.Tensor] | None = None
     centre: torch.Tensor | None = None
+
+
+def _join_node_parts(parts: list[dict[str, Any]]) -> dict[str, Any]:
+    """The per-group node results of ``_render_table`` joined along the images (dim 0)."""
+    if len(parts) == 1:
+        return parts[0]
+    out = {}
+    for key, first in parts[0].items():
+        if first is None:
+            out[key] = None
+        elif isinstance(first, _Ranges):
+            out[key] = _Ranges(**{f: None if getattr(first, f) is None else
+                                  (tuple(torch.cat([getattr(q[key], f)[i] for q in parts]) for i in range(2))
+                                   if isinstance(getattr(first, f), tuple) else torch.cat([getattr(q[key], f) for q in parts]))
+                                  for f in first.__dataclass_fields__})
+        else:
+            out[key] = torch.cat([q[key] for q in parts])
+    return out
+
+
+def _slice_node_parts(parts: dict[str, Any], sl: slice) -> dict[str, Any]:
+    """Images ``sl`` of the joined node results."""
+    out = {}
+    for key, v in parts.items():
+        if v is None:
+            out[key] = None
+        elif isinstance(v, _Ranges):
+            out[key] = _Ranges(**{f: None if getattr(v, f) is None else
+                                  (tuple(t[sl] for t in getattr(v, f)) if isinstance(getattr(v, f), tuple)
+                                   else getattr(v, f)[sl]) for f in v.__dataclass_fields__})
+        else:
+            out[key] = v[sl]
+    return out
 
 
 def _asinh(x: torch.Tensor) -> torch.Tensor:
@@ -1412,9 +1446,10 @@ def _render_table(
                              "call render(cameras, scene) without geometry=")
         tex = TextureTable(table, nz, nphi, B, dtype, device, scene, cg)
 
-    def one(sl: slice) -> torch.Tensor:
-        """Images ``sl``, start to end: spans, the model at the nodes, the fine tables, the pixels;
-        (b, H, W). Everything here is per image, so chunks run independently (``map_chunks``)."""
+    def nodes(sl: slice) -> dict[str, Any]:
+        """Images ``sl``: spans, and the model at the nodes (the mean's, and the texture's departures
+        from it), the part of the work made of many small operations: run for groups of images at
+        once (fewer, larger operations), then sliced per chunk of pixels (``one``)."""
         b_ = sl.stop - sl.start
         wd = p["wind_direction"][sl]
         rg = (_geometry_ranges(geometry, sl, wd, inv_eps[sl], iso, fold) if geometry is not None
@@ -1457,10 +1492,33 @@ def _render_table(
             t_s = t_s * p["air_scale"][sl, None, None].to(t_s.dtype)
         rb = p["rb"][sl, None, None].to(t_s.dtype)
         coarse = (rb - rb * t_rho + t_s).to(dtype)  # R_a at the nodes (b, nz, nphi)
+        out = dict(rg=rg, lo=lo, span_z=span_z, ph_nodes=ph_nodes, coarse=coarse, a=None if iso else a,
+                   b=None if iso else b)
         if textured:  # the realization's departure from R_a at the nodes, per quantile of the resolved slope
+            out["delta"], out["active"] = tex.node_values(sl, p, tex.field(sl, p), ph_nodes, sky, scene, q, altitude,
+                                                          earth_radius_m, eps[sl], lo, span_z)
+        return out
+
+    # where the chunks of pixels are smaller than 4 images (textured scenes), the nodes first, for
+    # groups of up to 4 images (their model's temporaries stay tens of MB) spread over the workers,
+    # every per-image tensor then joined over the batch; otherwise each chunk its own nodes
+    group = max(1, min(4, -(-B // max(1, torch.get_num_threads()))))
+    node_all = None
+    if chunk < group:
+        node_all = _join_node_parts(map_chunks(nodes, [slice(i, min(i + group, B)) for i in range(0, B, group)], device))
+
+    def one(sl: slice) -> torch.Tensor:
+        """Images ``sl``: the fine tables from the nodes' values, then the pixels; (b, H, W).
+        Everything here is per image, so chunks run independently (``map_chunks``)."""
+        b_ = sl.stop - sl.start
+        wd = p["wind_direction"][sl]
+        nd = nodes(sl) if node_all is None else _slice_node_parts(node_all, sl)
+        rg, lo, span_z, ph_nodes, coarse, a, b = (nd[k] for k in ("rg", "lo", "span_z", "ph_nodes", "coarse", "a", "b"))
+        delta = None
+        if textured:
             wf = tex.field(sl, p)
-            delta = tex.node_delta(sl, p, wf, ph_nodes, sky, scene, q, altitude,
-                                   earth_radius_m, eps[sl], lo, span_z)
+            if bool(nd["active"].any()):  # the fine texture volume of the chunk (None: nothing resolved)
+                delta = tex.volume(nd["delta"], sl, scene, altitude, earth_radius_m, eps[sl], lo, span_z)
         glint_tab = None  # (b,) bool: images whose glint the fine table holds (sunny, unfolded, no texture)
         # textured seas put their whitecaps on the crests, a fraction f_pix per pixel: the fine table
         # then carries the foam-free sea and the foam as two channels, mixed per pixel

@@ -677,7 +677,11 @@ class WaveField:
                 Differentiable (the gradient is 0 where w is 0 or 1).
         """
         f = self._footprint_tensor(footprint)
-        return torch.stack([_window(f, k) for k in self.bands.band_wavenumber], dim=-1)
+        # every band at once (one op each over (..., n_bands)), the arithmetic of _window
+        scale = torch.tensor([k / math.pi / (_WIN_HI - _WIN_LO) for k in self.bands.band_wavenumber], dtype=f.dtype,
+                             device=f.device)
+        t = torch.clamp(f[..., None] * scale - _WIN_LO / (_WIN_HI - _WIN_LO), 0.0, 1.0)
+        return 1.0 - t * t * (3.0 - 2.0 * t)
 
     def band_covariance(self) -> torch.Tensor:
         """Expected world-frame slope covariance of each band, (B, n_bands, 3) = (var_x, var_y, cov_xy).

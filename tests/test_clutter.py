@@ -157,6 +157,33 @@ def test_realization_depends_on_seed_and_time_only():
     assert float((other - alone).abs().max()) > 1e-6
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_images_of_a_batch_with_their_own_winds_and_poses_equal_the_images_alone(threads):
+    """The texture's nodes are evaluated for groups of images and sliced per chunk of pixels: image
+    i of a batch of 5, each with its own wind, direction, altitude, pitch and roll, equals image i
+    rendered alone and the batch rendered in one chunk (nodes and pixels together), to 1e-12."""
+    n = torch.get_num_threads()
+    torch.set_num_threads(threads)
+    try:
+        kw = dict(altitude_m=torch.tensor([6.0, 14.0, 9.0, 25.0, 11.0], dtype=torch.float64),
+                  pitch_deg=torch.tensor([-7.0, -4.0, -9.0, -3.0, -6.0], dtype=torch.float64),
+                  roll_deg=torch.tensor([0.0, 2.0, -1.5, 1.0, -3.0], dtype=torch.float64))
+        cams = rs.make_camera(20, 12, hfov_deg=8.0, batch_size=5, dtype=torch.float64, **kw)
+        wind = torch.tensor([5.0, 9.0, 13.0, 7.0, 11.0], dtype=torch.float64)
+        wd = torch.tensor([0.0, 0.7, -1.2, 2.5, -2.9], dtype=torch.float64)
+        sc = _scene([31, 32, 33, 34, 35], wind_speed=wind, wind_direction=wd)
+        batch = rs.render(cams, sc)
+        together = rs.render(cams, sc, chunk=5)
+        assert torch.allclose(batch, together, rtol=1e-12, atol=0)
+        for i in range(5):
+            one = rs.make_camera(20, 12, hfov_deg=8.0, batch_size=1, dtype=torch.float64,
+                                 **{k: v[i : i + 1] for k, v in kw.items()})
+            alone = rs.render(one, _scene([31 + i], wind_speed=float(wind[i]), wind_direction=float(wd[i])))
+            assert torch.allclose(batch[i], alone[0], rtol=1e-12, atol=0), i
+    finally:
+        torch.set_num_threads(n)
+
+
 def test_float32_agrees_with_float64():
     c64, c32 = _cams(1, pitch=-8.0), _cams(1, pitch=-8.0, dtype=torch.float32)
     a = rs.render(c64, _scene([7], time_s=3.0))
