@@ -98,8 +98,9 @@ class TabulatedSky:
         """Per (dtype, device): the nodes z, radiance r, PCHIP slopes d, and for the lookup a
         uniform bucket grid over [z₀, z_end] (origin, 1/width) whose width is the smallest node
         spacing, so a bucket meets at most two intervals, with per bucket its first interval and
-        where the next one starts (M, 2) (:mod:`roughsea_torch._lookup`); for a single table also per interval (N−1, 6) its start,
-        1/width and the power-form coefficients of the cubic in t ∈ [0, 1] (one gather a query)."""
+        where the next one starts (M, 2) (:mod:`roughsea_torch._lookup`); and per interval (of each
+        row of a batched table) its start, 1/width and the power-form coefficients of the cubic in
+        t ∈ [0, 1], (rows · (N−1), 6) (one gather a query)."""
         key = (dtype, device)
         if self.radiance.requires_grad or key not in self._cache:
             z64 = self.zenith.detach().double().cpu()
@@ -111,12 +112,13 @@ class TabulatedSky:
             bucket = (torch.tensor(z_0, dtype=dtype, device=device),
                       torch.tensor(inv_width, dtype=dtype, device=device),
                       torch.stack([start.to(dtype), split.to(dtype)], -1).to(device))
-            coef = None
-            if r.ndim == 1:  # y(t) = y0 + t (h d0 + t (3Δ − h(2 d0 + d1) + t (−2Δ + h(d0 + d1))))
-                h = z[1:] - z[:-1]
-                dy = r[1:] - r[:-1]
-                coef = torch.stack([z[:-1], 1.0 / h, r[:-1], h * d[:-1], 3 * dy - h * (2 * d[:-1] + d[1:]),
-                                    -2 * dy + h * (d[:-1] + d[1:])], -1)
+            # y(t) = y0 + t (h d0 + t (3Δ − h(2 d0 + d1) + t (−2Δ + h(d0 + d1)))), per interval (and per
+            # table row of a batched sky: (rows · (N − 1), 6), row-major)
+            h = z[1:] - z[:-1]
+            dy = r[..., 1:] - r[..., :-1]
+            d0, d1 = d[..., :-1], d[..., 1:]
+            coef = torch.stack([z[:-1].expand_as(dy), (1.0 / h).expand_as(dy), r[..., :-1], h * d0,
+                                3 * dy - h * (2 * d0 + d1), -2 * dy + h * (d0 + d1)], -1).reshape(-1, 6)
             out = (z, r, d, *bucket, coef)
             if self.radiance.requires_grad:
                 return out
@@ -136,27 +138,16 @@ class TabulatedSky:
         kb = ((th - z0) * inv_w).long().clamp_(0, bucket.shape[0] - 1).reshape(-1)
         sb = bucket.index_select(0, kb).reshape(*th.shape, 2)
         i = (sb[..., 0] + (th >= sb[..., 1]).to(th.dtype)).long().clamp_(max=z.numel() - 2)
-        if coef is not None:
-            # one gather of the interval's start, 1/width and four coefficients
-            c = coef.index_select(0, i.reshape(-1)).reshape(*i.shape, coef.shape[-1])
-            t = (theta - c[..., 0]) * c[..., 1]
-            return c[..., 2] + t * (c[..., 3] + t * (c[..., 4] + t * c[..., 5]))
-        x0 = z[i]
-        h = z[i + 1] - x0
-        t = (theta - x0) / h
-        lead = torch.broadcast_shapes(r.shape[:-1], i.shape[:-1])
-        rb = r.expand(*lead, r.shape[-1])
-        db = d.expand(*lead, d.shape[-1])
-        ib = i.expand(*lead, i.shape[-1])
-        y0, y1 = rb.gather(-1, ib), rb.gather(-1, ib + 1)
-        d0, d1 = db.gather(-1, ib), db.gather(-1, ib + 1)
-        t2 = t * t
-        t3 = t2 * t
-        h00 = 2 * t3 - 3 * t2 + 1
-        h10 = t3 - 2 * t2 + t
-        h01 = -2 * t3 + 3 * t2
-        h11 = t3 - t2
-        return h00 * y0 + h10 * h * d0 + h01 * y1 + h11 * h * d1
+        if r.ndim > 1:  # a batched sky: the query's interval in its own row of the table
+            lead = torch.broadcast_shapes(r.shape[:-1], i.shape[:-1])
+            shape = (*lead, i.shape[-1])
+            rows = torch.arange(int(np.prod(r.shape[:-1])), device=i.device).reshape(*r.shape[:-1], 1)
+            i = (rows * (z.numel() - 1)).expand(shape) + i.expand(shape)
+            theta = theta.expand(shape)
+        # one gather of the interval's start, 1/width and four coefficients
+        c = coef.index_select(0, i.reshape(-1)).reshape(*i.shape, coef.shape[-1])
+        t = (theta - c[..., 0]) * c[..., 1]
+        return c[..., 2] + t * (c[..., 3] + t * (c[..., 4] + t * c[..., 5]))
 
     def with_radiance(self, radiance: torch.Tensor) -> TabulatedSky:
         """The same zenith nodes with other (already validated) radiance rows."""

@@ -213,6 +213,14 @@ def test_pchip_matches_scipy():
     np.testing.assert_allclose(sky(torch.cos(torch.tensor(qz))).numpy(), want, rtol=1e-9)
     two = sky.with_radiance(torch.stack([sky.radiance, 0.5 * sky.radiance]))(torch.cos(torch.tensor(np.stack([qz, qz]))))
     np.testing.assert_allclose(two.numpy(), np.stack([want, 0.5 * want]), rtol=1e-9)
+    # a table per leading element broadcast over a middle dim of the query: (2, 1, N) rows, (2, 3, Q)
+    # queries (row i serves every query [i, j, :]; the lookup indexes each query's own row)
+    rows = torch.stack([sky.radiance, 0.5 * sky.radiance])[:, None]
+    qq = np.stack([np.stack([qz, qz[::-1], qz]), np.stack([qz[::-1], qz, qz])])
+    got3 = sky.with_radiance(rows)(torch.cos(torch.tensor(qq))).numpy()
+    for i, f in enumerate((1.0, 0.5)):
+        for j in range(3):
+            np.testing.assert_allclose(got3[i, j], f * PchipInterpolator(z, sky.radiance.numpy())(qq[i, j]), rtol=1e-9)
 
 
 def test_band_radiance_matches_scipy_quad_with_a_tabulated_response():
