@@ -1698,7 +1698,10 @@ def _render_table(
 
             x_r, v_r, v_t = crest_var[0]
             f_pix = _crest_foam_fraction(x_r, v_r, v_t, p["foam"][sl].to(dtype)[:, None, None])
-            vals = torch.lerp(vals, foam_vals, f_pix)
+            # no foam in the sky: there f_pix would be W, and the lerp would take that share of the
+            # sky pixels from the foam channel's sky rows, which lack the day's scattered sky
+            # (added to the sky pixels of channel 0 above)
+            vals = torch.lerp(vals, foam_vals, torch.where(sea, f_pix, torch.zeros_like(f_pix)))
         if sunny and has_sky:  # the sun's disk itself, where it is in view
             ifov = (1.0 / cg.cameras.fx.to(dtype))[sl]
             vals = vals + _sun_disk_pixels(scene, B, sl, cos, dx, dy, ~sea, ifov)
