@@ -443,7 +443,8 @@ class TextureTable:
         del col, z
         grid = torch.stack([g0, gy], 1)
         read = F.grid_sample(vol, grid.permute(0, 2, 3, 1), mode="bilinear", padding_mode="border", align_corners=True)
-        if grid.requires_grad:  # (grid_sample keeps its grid for the backward pass)
+        if torch.is_grad_enabled() and (grid.requires_grad or vol.requires_grad):
+            # (grid_sample keeps its grid for the backward pass of either)
             grid = torch.stack([g0 + n_az * scale, gy], 1)
         else:
             grid[:, 0] += n_az * scale  # the next slice of x, one block of columns to the right
