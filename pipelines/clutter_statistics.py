@@ -154,7 +154,7 @@ def main() -> None:
     fig, ax = plt.subplots(figsize=(6, 3.6))
     lines += ["## Clutter against range (LWIR, midlatitude summer, 20 m, 640 px over 30°)", "",
               "σ of the brightness temperature about the expectation image, per image row, 16 realizations: with the "
-              "whitecaps on the crests (the default, `foam=None`: Monahan's fraction) and without (`foam=0`, the waves' "
+              "whitecaps on the crests (the default, `foam=\"auto\"`: Monahan's fraction) and without (`foam=0`, the waves' "
               "slopes alone).", "",
               "| wind [m/s] | σ at 100 m [K] | σ at 300 m [K] | σ at 1 km [K] | without foam: 100 m | 300 m | 1 km |",
               "|---:|---:|---:|---:|---:|---:|---:|"]

@@ -351,8 +351,8 @@ class SeaScene:
     def wave_field(self, B: int, dtype: torch.dtype, device: torch.device, sl: slice = slice(None),
                    min_band_share: float | None = None) -> Any:
         """The :class:`~roughsea_torch.waves.WaveField` of images ``sl`` (textured scenes only),
-        without the bands that carry less than ``min_band_share`` of an image's slope variance
-        (default ``TableSize.texture_min_band_share``, 1e-8). The last 64 (per group of images the
+        without the bands that carry less than ``min_band_share`` of an image's slope variance and
+        of its crest variable's (default ``TableSize.texture_min_band_share``, 1e-8). The last 64 (per group of images the
         renderer asks for) are kept while the scene's wind, direction and seed are unchanged (their
         random amplitudes are drawn once)."""
         from .waves import WaveField
@@ -518,9 +518,10 @@ class TableSize:
             realization, their variance left to the unresolved statistics (``WaveField(...,
             min_band_share=)``): on the spectrum's low-k flank far below the peak of a light wind.
             1e-8 skips a fifth of the band lookups of the README's batch; it moves a realization by
-            up to 3e-5 of the radiance, in the rows at the horizon, where a footprint resolves only
-            the longest waves and the radiance is most sensitive to slope (1e-6 would skip 29 % and
-            move it by 1e-4). 0 keeps every band.
+            up to 3e-5 of the radiance at 512×640 (6e-5 at 128×160: coarser pixels resolve fewer
+            bands), in the rows at the horizon, where a footprint resolves only the longest waves
+            and the radiance is most sensitive to slope (1e-6 would skip 29 % and move it by 1e-4,
+            7e-4 at 128×160). 0 keeps every band.
 
     The defaults: 17 zenith nodes are as accurate as 21 (``pipelines/accuracy_pareto.py``, renderer
     panel: 1.2e-6 against per-pixel evaluation over 9276 cases, W 2–40 m/s); 3072 fine rows keep the

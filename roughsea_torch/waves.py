@@ -376,10 +376,12 @@ class WaveField:
             in [0, 1); default 0 (every band). Left-out bands have zero amplitudes, so every
             statistic (:meth:`band_covariance`, :meth:`resolved_covariance`, the variances) is
             that of the field without them, and :meth:`sample` skips them. The renderer uses
-            1e-6 (``SeaScene.wave_field``): on the spectrum's low-k flank, far below the peak of a
-            light wind, whole octaves carry 1e-10 to 1e-7 of the slope variance (their slope
-            amplitude 1e-5 to 3e-4 of the field's); they still carry elevation, which the
-            renderer does not use.
+            ``TableSize.texture_min_band_share`` (1e-8; ``SeaScene.wave_field``): on the
+            spectrum's low-k flank, far below the peak of a light wind, whole octaves carry 1e-10
+            to 1e-7 of the slope variance (their slope amplitude 1e-5 to 3e-4 of the field's);
+            they still carry elevation, which the renderer does not use. The set left out changes
+            in steps with the wind, so a realization jumps by that little as the wind crosses a
+            threshold (the gradient with respect to the wind does not see the step).
 
     Synthesis (Tessendorf 2001, with two changes that make the result exact and one-way):
         For band o on its tile (length L_o, N × N texels, lattice k = Δk_o (i, j)), every mode of
