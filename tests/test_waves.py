@@ -269,20 +269,40 @@ def test_sample_is_pointwise_whatever_the_order_and_the_skipped_blocks():
             assert torch.allclose(one[key], a[key][:, i : i + 1], rtol=1e-13, atol=1e-15), (key, i)
 
 
+def test_sample_does_not_depend_on_how_points_are_chunked(monkeypatch):
+    """Three images of 300 000 points each: the default chunks (2**18 / 3 points, which do not start
+    on 512-point blocks) against one chunk, bitwise, with a footprint that ramps across every band's
+    window (so runs, windowed spans and chunk boundaries all meet part-way through blocks)."""
+    gen = torch.Generator().manual_seed(8)
+    field = WaveField(torch.tensor([5.0, 9.0, 14.0]), [4, 5, 6], wind_direction=torch.tensor([0.2, 1.1, -2.0]),
+                      dtype=torch.float64)
+    n = 300_000
+    x = (torch.rand(3, n, generator=gen, dtype=torch.float64) - 0.5) * 4000
+    y = (torch.rand(3, n, generator=gen, dtype=torch.float64) - 0.5) * 4000
+    f = torch.logspace(-3.5, 3.5, n, dtype=torch.float64).expand(3, -1) * torch.tensor([[1.0], [0.7], [1.3]],
+                                                                                        dtype=torch.float64)
+    chunked = field.sample(x, y, 1.5, footprint=f, crest=True)
+    monkeypatch.setattr(waves, "_CHUNK_ELEMENTS", 2**22)
+    whole = field.sample(x, y, 1.5, footprint=f, crest=True)
+    for key in whole:
+        assert torch.equal(chunked[key], whole[key]), key
+
+
 def test_min_band_share_leaves_out_the_weak_bands_and_only_them():
     """WaveField(min_band_share=s) drops, per image, the bands that carry less than s of the image's
     slope variance and of its crest variable's (shares computed here from the full field), and
     nothing else: their covariance and variances are 0, the others' unchanged, and the sample is the
     full field's minus those bands' contribution (the full field's sample at the footprint where its
     window keeps exactly those bands, 1/√2 π/k of the last one)."""
-    wind = torch.tensor([3.0, 20.0], dtype=torch.float64)
-    full = WaveField(wind, [1, 2], dtype=torch.float64)
-    part = WaveField(wind, [1, 2], dtype=torch.float64, min_band_share=1e-6)
+    wind = torch.tensor([3.0, 6.0, 20.0], dtype=torch.float64)
+    full = WaveField(wind, [1, 2, 3], dtype=torch.float64)
+    part = WaveField(wind, [1, 2, 3], dtype=torch.float64, min_band_share=1e-6)
     cov = full.band_covariance()
     slope = cov[..., 0] + cov[..., 1]
     crest = full.band_crest_variance()
     weak = (slope / slope.sum(-1, keepdim=True) < 1e-6) & (crest / crest.sum(-1, keepdim=True) < 1e-6)
-    assert bool(weak[0, :2].all()) and not bool(weak[0].all())  # 3 m/s: the lowest bands go
+    n_weak = weak.sum(-1).tolist()
+    assert n_weak[0] > n_weak[1] > 0 and not bool(weak[0].all())  # 3 and 6 m/s drop different bands
     assert torch.equal(part.band_covariance()[weak], torch.zeros_like(cov[weak]))
     assert torch.equal(part.band_covariance()[~weak], cov[~weak])
     assert torch.equal(part.band_crest_variance()[~weak], crest[~weak])
@@ -290,16 +310,23 @@ def test_min_band_share_leaves_out_the_weak_bands_and_only_them():
     gen = torch.Generator().manual_seed(2)
     x = (torch.rand(1, 5000, generator=gen, dtype=torch.float64) - 0.5) * 5000
     y = (torch.rand(1, 5000, generator=gen, dtype=torch.float64) - 0.5) * 5000
-    last = int(torch.nonzero(weak[0])[-1])
-    assert bool(weak[0, : last + 1].all())  # a prefix: the spectrum's low-k flank
-    f_weak = (1.0 / math.sqrt(2.0)) * math.pi / full.bands.band_wavenumber[last]
-    one = lambda fld, **k: {key: v[:1] for key, v in fld.sample(x.expand(2, -1), y.expand(2, -1), 4.0, crest=True, **k).items()}  # noqa: E731
-    a, b = one(full), one(part)
-    low = one(full, footprint=torch.full((2, 5000), f_weak, dtype=torch.float64))
+    f_weak = torch.full((3, 5000), 0.0, dtype=torch.float64)
+    for i in range(3):
+        if n_weak[i]:
+            last = int(torch.nonzero(weak[i])[-1])
+            assert bool(weak[i, : last + 1].all())  # a prefix: the spectrum's low-k flank
+            f_weak[i] = (1.0 / math.sqrt(2.0)) * math.pi / full.bands.band_wavenumber[last]
+        else:
+            f_weak[i] = math.inf  # nothing dropped: nothing to subtract
+    xs, ys = x.expand(3, -1), y.expand(3, -1)
+    a, b = full.sample(xs, ys, 4.0, crest=True), part.sample(xs, ys, 4.0, crest=True)
+    low = full.sample(xs, ys, 4.0, footprint=f_weak, crest=True)
     for key in a:
-        scale = float(a[key].abs().max())
-        assert float((a[key] - low[key] - b[key]).abs().max()) < 1e-9 * scale, key
-        assert float((a[key] - b[key]).abs().max()) > 0.0, key  # the dropped bands were not zero
+        for i in range(3):  # every image against its own dropped set
+            scale = float(a[key][i].abs().max())
+            assert float((a[key][i] - low[key][i] - b[key][i]).abs().max()) < 1e-9 * scale, (key, i)
+            if n_weak[i]:
+                assert float((a[key][i] - b[key][i]).abs().max()) > 0.0, (key, i)  # the dropped bands were not zero
     with pytest.raises(ValueError, match=r"min_band_share must be a number in \[0, 1\)"):
         WaveField(5.0, 0, min_band_share=1.0)
     with pytest.raises(ValueError, match=r"min_band_share must be a number in \[0, 1\)"):
