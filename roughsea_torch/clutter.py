@@ -230,7 +230,13 @@ def reconcile_scale(field_cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], 
     # largest eigenvalue of Σ⁻¹ C (2×2): trace and determinant
     tr = (vy * uu - 2 * cxy * uv + vx * vv) / det
     dt = (uu * vv - uv * uv) / det
-    lam_max = 0.5 * (tr + torch.sqrt((tr * tr - 4 * dt).clamp_min(0.0)))
+    # √ of the discriminant where it is > 0 only: at 0 (a repeated eigenvalue, e.g. nothing resolved,
+    # C = 0, at sky pixels and in the far field) √'s derivative is infinite, and times the zero
+    # gradient of a clamp it made the pose gradient NaN
+    disc = tr * tr - 4 * dt
+    pos = disc > 0
+    root = torch.where(pos, torch.sqrt(torch.where(pos, disc, torch.ones_like(disc))), torch.zeros_like(disc))
+    lam_max = 0.5 * (tr + root)
     return torch.sqrt(torch.clamp(limit / lam_max.clamp_min(1e-30), max=1.0))
 
 

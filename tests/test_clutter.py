@@ -243,6 +243,33 @@ def test_gradient_of_the_table_render_with_respect_to_one_scene_parameter_alone(
     assert abs(float(g) - fd) < 5e-3 * abs(fd), (float(g), fd)
 
 
+def test_pose_gradient_is_finite_with_the_horizon_in_view():
+    """A textured default scene (LOWTRAN sky, path, foam) with the horizon in view: d/d(pitch) of a
+    weighted image sum is finite for both methods (it was NaN for both: reconcile_scale took √ of a
+    zero discriminant where nothing is resolved, the sky pixels and the far field), the per-pixel
+    method's equals its central difference to 1e-4 (1e-5 measured), and the table's is within 3 % of
+    it (1.9 % measured: near the horizon the table's interpolation error moves with the pose)."""
+    w = torch.linspace(0.5, 1.5, 16, dtype=torch.float64)[:, None]
+
+    def objective(p, method):
+        cams = rs.make_camera(16, 20, hfov_deg=20.0, dtype=torch.float64, altitude_m=10.0, pitch_deg=p)
+        img = rs.render(cams, rs.SeaScene(wind_speed=6.0, sea_temperature=290.0, seed=[3], time_s=1.0), method=method)
+        return (img[0, 0] * w).sum()
+
+    assert bool((~rs.view_geometry(rs.make_camera(16, 20, hfov_deg=20.0, dtype=torch.float64, altitude_m=10.0,
+                                                  pitch_deg=-5.0)).is_sea).any())
+    grads = {}
+    for method in ("direct", "table"):
+        pitch = torch.tensor(-5.0, dtype=torch.float64, requires_grad=True)
+        (grads[method],) = torch.autograd.grad(objective(pitch, method), pitch)
+        assert math.isfinite(float(grads[method])), method
+    h = 1e-4
+    fd = float(objective(torch.tensor(-5.0 + h, dtype=torch.float64), "direct")
+               - objective(torch.tensor(-5.0 - h, dtype=torch.float64), "direct")) / (2 * h)
+    assert abs(float(grads["direct"]) - fd) < 1e-4 * abs(fd)
+    assert abs(float(grads["table"]) - float(grads["direct"])) < 0.03 * abs(float(grads["direct"]))
+
+
 def test_resolved_plus_unresolved_covariance_is_the_slope_law():
     """The synthesized slopes at a footprint (empirical, many points and seeds) plus the unresolved
     covariance the renderer uses equal SlopeStatistics (anisotropic Cox–Munk), upwind and
