@@ -653,9 +653,8 @@ def _azimuth_coordinate(dx: torch.Tensor, dy: torch.Tensor, offset: torch.Tensor
     # atan2(dy, dx) is the ray's azimuth, the LOS's + π: the same modulo π. With the offset wrapped
     # into [0, π) per image, (atan2 + offset)/π + 1 lies in [0, 3): its frac is the remainder
     # (torch.remainder, a floor division, costs ~4x frac on the CPU)
-    start = 1.0 + torch.remainder(offset, math.pi) / math.pi
-    o = torch.frac(torch.addcmul(start[:, None, None].to(dy.dtype), torch.atan2(dy, dx), torch.full_like(dy[:1, :1, :1], 1.0 / math.pi)))
-    o = o.mul_(math.pi) if not o.requires_grad else o * math.pi
+    start = (1.0 + torch.remainder(offset, math.pi) / math.pi).to(dy.dtype)[:, None, None]
+    o = torch.frac(torch.atan2(dy, dx).mul_(1.0 / math.pi).add_(start)).mul_(math.pi)
     return (o - math.pi / 2).abs() if fold else o
 
 
@@ -734,37 +733,17 @@ class _Ranges:
     centre: torch.Tensor | None = None
 
 
-def _join_node_parts(parts: list[dict[str, Any]]) -> dict[str, Any]:
-    """The per-group node results of ``_render_table`` joined along the images (dim 0)."""
-    if len(parts) == 1:
-        return parts[0]
-    out = {}
-    for key, first in parts[0].items():
-        if first is None:
-            out[key] = None
-        elif isinstance(first, _Ranges):
-            out[key] = _Ranges(**{f: None if getattr(first, f) is None else
-                                  (tuple(torch.cat([getattr(q[key], f)[i] for q in parts]) for i in range(2))
-                                   if isinstance(getattr(first, f), tuple) else torch.cat([getattr(q[key], f) for q in parts]))
-                                  for f in first.__dataclass_fields__})
-        else:
-            out[key] = torch.cat([q[key] for q in parts])
-    return out
-
-
-def _slice_node_parts(parts: dict[str, Any], sl: slice) -> dict[str, Any]:
-    """Images ``sl`` of the joined node results."""
-    out = {}
-    for key, v in parts.items():
-        if v is None:
-            out[key] = None
-        elif isinstance(v, _Ranges):
-            out[key] = _Ranges(**{f: None if getattr(v, f) is None else
-                                  (tuple(t[sl] for t in getattr(v, f)) if isinstance(getattr(v, f), tuple)
-                                   else getattr(v, f)[sl]) for f in v.__dataclass_fields__})
-        else:
-            out[key] = v[sl]
-    return out
+def _map_nodes(fn: Any, *vals: Any) -> Any:
+    """``fn`` over the tensors of ``_render_table``'s node results (a tensor, a tuple of them, a
+    :class:`_Ranges` or None), several results zipped."""
+    v = vals[0]
+    if v is None:
+        return None
+    if isinstance(v, _Ranges):
+        return _Ranges(**{f: _map_nodes(fn, *(getattr(x, f) for x in vals)) for f in v.__dataclass_fields__})
+    if isinstance(v, tuple):
+        return tuple(_map_nodes(fn, *z) for z in zip(*vals))
+    return fn(*vals)
 
 
 def _asinh(x: torch.Tensor) -> torch.Tensor:
@@ -1118,6 +1097,13 @@ def _over_kept_pixels(keep: torch.Tensor, fn: Any, dtype: torch.dtype) -> torch.
     return out.reshape(b_, H, W)
 
 
+def _upwind_los(x: torch.Tensor, y: torch.Tensor, cw: torch.Tensor, sw: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """(cos φ̂, sin φ̂) of the line of sight in the upwind frame, from the ray's world components x, y
+    (the line of sight is −(x, y) horizontally) and the cosine and sine of the wind direction."""
+    inv = torch.rsqrt((x * x + y * y).clamp_min(1e-30))
+    return -(x * cw + y * sw) * inv, (x * sw - y * cw) * inv
+
+
 def _glint_mask(p: dict[str, Any], sl: slice, sun: Any, cos_t: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor,
                 sea: torch.Tensor) -> torch.Tensor:
     """The sea pixels of images ``sl`` that can see glint (b, H, W) bool: those whose specular slope lies
@@ -1130,12 +1116,9 @@ def _glint_mask(p: dict[str, Any], sl: slice, sun: Any, cos_t: torch.Tensor, dx:
     def one(m: int, at: Any) -> torch.Tensor:
         wd, a2, b2, c2, sz, sa, radius = (v[m] for v in per_img)
         ct = at(cos_t).clamp(0.0, 1.0)
-        x, y = at(dx), at(dy)
         st = torch.sqrt((1 - ct * ct).clamp_min(0.0))
-        inv = torch.rsqrt((x * x + y * y).clamp_min(1e-30))
-        cw, sw = torch.cos(wd), torch.sin(wd)
-        ex, ey = -x * inv, -y * inv  # LOS azimuth (world) → the upwind frame
-        vx_, vy_ = st * (ex * cw + ey * sw), st * (ey * cw - ex * sw)
+        cph, sph = _upwind_los(at(dx), at(dy), torch.cos(wd), torch.sin(wd))
+        vx_, vy_ = st * cph, st * sph
         wx, wy, wz = torch.sin(sz) * torch.cos(sa), torch.sin(sz) * torch.sin(sa), torch.cos(sz)
         qz = ct + wz
         sgx, sgy = (vx_ + wx) / qz, (vy_ + wy) / qz
@@ -1302,10 +1285,8 @@ def _glint_sharp_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: to
 
     def one(m: int, at: Any) -> torch.Tensor:
         cw, sw, vx, vy, cxy, n_, k_, tz, tp, al = (v[m] for v in per_img)
-        c, x, y = at(cos_t), at(dx), at(dy)
-        inv = torch.rsqrt((x * x + y * y).clamp_min(1e-30))
-        cph = -(x * cw + y * sw) * inv  # x' = x cos wd + y sin wd, y' = −x sin wd + y cos wd
-        sph = (x * sw - y * cw) * inv
+        c = at(cos_t)
+        cph, sph = _upwind_los(at(dx), at(dy), cw, sw)
         return _glint_sharp(c, torch.sqrt((1.0 - c * c).clamp_min(0.0)), cph, sph, vx, vy, cxy, zero, zero, n_, k_, tz, tp,
                             al)[0]
 
@@ -1486,7 +1467,11 @@ def _render_table(
                 a, b = a.clamp_min(0.0), b.clamp_max(math.pi / 2)
             # the pixels' o = wrap_π(φ̂ − c) + π/2: nodes at φ̂ = c + o − π/2 (folded: φ̂ = o = ψ)
             shift = 0.0 if fold else math.pi / 2
-            ph_nodes = (rg.centre[:, None] - shift + a[:, None] + (b - a)[:, None] * (xp_t + 1) / 2).to(dtype)
+
+            def az_nodes(x: torch.Tensor) -> torch.Tensor:  # Lobatto nodes x ∈ [−1, 1] → φ̂ over [a, b]
+                return (rg.centre[:, None] - shift + a[:, None] + (b - a)[:, None] * (x + 1) / 2).to(dtype)
+
+            ph_nodes = az_nodes(xp_t)
 
         # ---- the model at the nodes; T_s, T_ρ in its working dtype: float64 without shadowing,
         # where they grow like σ∥/cos θ̂ and R_B (1 − T_ρ) + T_s cancels them (expectation._work_dtype)
@@ -1508,7 +1493,7 @@ def _render_table(
         if textured:  # the realization's departure from R_a at the nodes, per quantile of the resolved slope
             ph_tex, sky_tex = ph_nodes, sky
             if nphi_tex != nphi:  # its own azimuth nodes, and the scattered sky along their mirror azimuths
-                ph_tex = (rg.centre[:, None] - shift + a[:, None] + (b - a)[:, None] * (xp_tex + 1) / 2).to(dtype)
+                ph_tex = az_nodes(xp_tex)
                 sky_tex = _sky_with_day(select_sky(p["sky"], sl), day, p, sl, ph_tex[:, None, :])
             out["delta"], out["active"] = tex.node_values(sl, p, tex.field(sl, p), ph_tex, sky_tex, scene, q, altitude,
                                                           earth_radius_m, eps[sl], lo, span_z)
@@ -1520,14 +1505,15 @@ def _render_table(
     group = max(1, min(4, -(-B // max(1, torch.get_num_threads()))))
     node_all = None
     if chunk < group:
-        node_all = _join_node_parts(map_chunks(nodes, [slice(i, min(i + group, B)) for i in range(0, B, group)], device))
+        parts = map_chunks(nodes, [slice(i, min(i + group, B)) for i in range(0, B, group)], device)
+        node_all = {k: _map_nodes(lambda *t: torch.cat(t), *(q[k] for q in parts)) for k in parts[0]}
 
     def one(sl: slice) -> torch.Tensor:
         """Images ``sl``: the fine tables from the nodes' values, then the pixels; (b, H, W).
         Everything here is per image, so chunks run independently (``map_chunks``)."""
         b_ = sl.stop - sl.start
         wd = p["wind_direction"][sl]
-        nd = nodes(sl) if node_all is None else _slice_node_parts(node_all, sl)
+        nd = nodes(sl) if node_all is None else {k: _map_nodes(lambda t: t[sl], v) for k, v in node_all.items()}
         rg, lo, span_z, ph_nodes, coarse, a, b = (nd[k] for k in ("rg", "lo", "span_z", "ph_nodes", "coarse", "a", "b"))
         delta = None
         if textured:

@@ -877,7 +877,7 @@ class WaveField:
         band whose tile is zero for every image (``min_band_share``) is skipped."""
         batch, npts = xy.shape[0], xy.shape[1]
         n_ch = tiles.shape[2]
-        acc = None
+        acc = torch.zeros((batch, n_ch, npts), dtype=self.dtype, device=self.device)
         chunk = max(1024, _CHUNK_ELEMENTS // batch)
         f_all = None if f is None else f.detach()
         if f_all is not None:  # per block of points: the footprint's least and largest value over the batch
@@ -906,36 +906,32 @@ class WaveField:
                     grid = torch.frac(grid) if grid.requires_grad else torch.frac(grid, out=grid)
                     values = F_nn.grid_sample(tile, grid.unsqueeze(1), mode="bilinear", padding_mode="border",
                                               align_corners=True).squeeze(2)  # (B, C, P')
-                    if part is not None:
-                        a0 = a // _BLOCK * _BLOCK
-                        w_runs = _runs(part[a // _BLOCK : -(-e // _BLOCK)], e - a0, a0)
-                        if w_runs:  # the window where it may be below 1 (exactly 1 elsewhere), one span
-                            u, v = max(a, w_runs[0][0]), min(e, w_runs[-1][1])
+                    flagged = None if part is None else np.flatnonzero(part[a // _BLOCK : -(-e // _BLOCK)])
+                    if flagged is not None and flagged.size:  # the window where it may be below 1 (exactly 1
+                        # elsewhere), one span from the first to the last flagged block of the chunk
+                        u = max(a, (a // _BLOCK + int(flagged[0])) * _BLOCK)
+                        v = min(e, (a // _BLOCK + int(flagged[-1]) + 1) * _BLOCK)
+                        if u < v:
                             w = _window(f[:, u:v], k_o).unsqueeze(1)
                             if values.requires_grad or w.requires_grad:
                                 values = torch.cat([values[..., : u - a], values[..., u - a : v - a] * w,
                                                     values[..., v - a :]], -1)
                             else:
                                 values[..., u - a : v - a] *= w
-                    if acc is None:
-                        acc = torch.zeros((batch, n_ch, npts), dtype=self.dtype, device=self.device)
                     acc[..., a:e] += values  # in place on our own buffer; autograd records the slice
-        if acc is None:
-            acc = torch.zeros((batch, n_ch, npts), dtype=self.dtype, device=self.device)
         return acc
 
 
-def _runs(blocks: np.ndarray, npts: int, offset: int = 0, gap: int = 4) -> list[tuple[int, int]]:
-    """Point ranges [a, b) covering the True blocks of ``blocks`` (blocks of ``_BLOCK`` points from
-    point ``offset``), runs less than ``gap`` blocks apart merged (fewer, larger calls), clipped to
-    ``offset + npts``."""
+def _runs(blocks: np.ndarray, npts: int, gap: int = 4) -> list[tuple[int, int]]:
+    """Point ranges [a, b) covering the True blocks of ``blocks`` (blocks of ``_BLOCK`` points), runs
+    less than ``gap`` blocks apart merged (fewer, larger calls), clipped to ``npts``."""
     on = np.flatnonzero(blocks)
     if on.size == 0:
         return []
     cut = np.flatnonzero(np.diff(on) > gap)
     starts = np.concatenate([on[:1], on[cut + 1]])
     ends = np.concatenate([on[cut], on[-1:]]) + 1
-    return [(offset + int(a) * _BLOCK, min(offset + npts, offset + int(b) * _BLOCK)) for a, b in zip(starts, ends)]
+    return [(int(a) * _BLOCK, min(npts, int(b) * _BLOCK)) for a, b in zip(starts, ends)]
 
 
 # ---------------------------------------------------------------------------------------------
