@@ -11,7 +11,9 @@ wind, and how fast the clutter decorrelates in time.
    the expectation image [K] per image row, against the row's slant range, for winds of 3, 6, 10 and
    15 m/s (16 realizations each), with the whitecaps on the crests (the default) and without
    (``foam=0``: the waves' slopes alone).
-3. **Time.** A 4 s clip at 25 Hz of one realization: the correlation of the clutter (frame minus
+3. **Foam against the sea.** The brightness temperature of a sea without foam and of one wholly
+   under foam at view zeniths of 60–88° (LWIR, midlatitude summer, 6 and 12 m/s).
+4. **Time.** A 4 s clip at 25 Hz of one realization: the correlation of the clutter (frame minus
    expectation) between frames against the lag, and its 1/e time, beside Schwering's (1991)
    measurement of marine LWIR backgrounds ("time constants of about 1 second for the images in
    the sequence to become uncorrelated", Proc. SPIE 1486, doi:10.1117/12.45749).
@@ -95,6 +97,21 @@ def clutter_vs_range(winds=(3.0, 6.0, 10.0, 15.0), n=16):
     return rng[sea], out
 
 
+def foam_against_sea(winds=(6.0, 12.0), pitches=(-30.0, -15.0, -5.0, -2.0)):
+    """Brightness temperature [K] of the sea without foam and of a sea wholly under foam (expectation
+    images, ``foam=0`` and ``foam=1``), LWIR, midlatitude summer with path, sea at 293 K, a narrow
+    camera 20 m up; at the view zeniths the pitches give (image centre)."""
+    cams = rs.make_camera(64, 8, hfov_deg=2.0, altitude_m=20.0, pitch_deg=torch.tensor(pitches, dtype=torch.float64),
+                          batch_size=len(pitches), dtype=torch.float64)
+    vz = torch.rad2deg(rs.view_geometry(cams).view_zenith[:, 32, 4])
+    rows = []
+    for w in winds:
+        sea, foam = (rs.render(cams, rs.SeaScene(wind_speed=w, sea_temperature=293.0, foam=f),
+                               output="brightness_temperature")[:, 0, 32, 4] for f in (0.0, 1.0))
+        rows += [(w, float(z), float(a), float(b)) for z, a, b in zip(vz, sea, foam)]
+    return rows
+
+
 def decorrelation(fps=25.0, seconds=4.0, wind=8.0):
     H, W = 128, 160
     cams = rs.make_camera(H, W, hfov_deg=20.0, altitude_m=20.0, pitch_deg=-4.0)
@@ -169,6 +186,12 @@ def main() -> None:
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(out / "clutter_vs_range.png", dpi=120)
+
+    lines += ["", "## Foam against the sea (LWIR, midlatitude summer, sea 293 K, 20 m, expectation images)", "",
+              "Brightness temperature of the sea without foam (`foam=0`) and wholly under foam (`foam=1`): near grazing "
+              "the model's foam is darker than the sea (README, *Textured seas*).", "",
+              "| wind [m/s] | view zenith [deg] | sea [K] | foam [K] |", "|---:|---:|---:|---:|"]
+    lines += [f"| {w:g} | {z:.1f} | {a:.2f} | {b:.2f} |" for w, z, a, b in foam_against_sea()]
 
     lags, corr, t_e = decorrelation()
     lines += ["", "## Temporal decorrelation (25 Hz, wind 8 m/s, 20 m, 128×160 over 20°)", "",

@@ -518,10 +518,10 @@ class TableSize:
             realization, their variance left to the unresolved statistics (``WaveField(...,
             min_band_share=)``): on the spectrum's low-k flank far below the peak of a light wind.
             1e-8 skips a fifth of the band lookups of the README's batch; it moves a realization by
-            up to 3e-5 of the radiance at 512×640 (6e-5 at 128×160: coarser pixels resolve fewer
-            bands), in the rows at the horizon, where a footprint resolves only the longest waves
-            and the radiance is most sensitive to slope (1e-6 would skip 29 % and move it by 1e-4,
-            7e-4 at 128×160). 0 keeps every band.
+            up to 3e-5 of the radiance (two 96×128 images, 6 and 14 m/s) to 6e-5 (eight of the
+            benchmark's poses at 128×160), in the rows at the horizon, where a footprint resolves
+            only the longest waves and the radiance is most sensitive to slope (1e-6 would skip
+            29 % and move it by 1e-4 and 7e-4 on the same images). 0 keeps every band.
 
     The defaults: 17 zenith nodes are as accurate as 21 (``pipelines/accuracy_pareto.py``, renderer
     panel: 1.2e-6 against per-pixel evaluation over 9276 cases, W 2–40 m/s); 3072 fine rows keep the
