@@ -50,7 +50,8 @@ import torch
 
 from .slopes import SlopeStatistics
 
-__all__ = ["visible_slope", "unresolved_statistics", "two_scale_statistics", "pixel_resolved_slope", "along_view", "footprint",
+__all__ = ["visible_slope", "unresolved_statistics", "two_scale_statistics", "pixel_resolved_slope", "resolved_quantile",
+           "along_view", "footprint",
            "reconcile_scale"]
 
 _SQRT_HALF = math.sqrt(0.5)
@@ -185,20 +186,32 @@ def along_view(cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], ex: torch.T
     return torch.where(ok, var_a, torch.zeros_like(var_a)), kappa
 
 
+def resolved_quantile(
+    slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor],
+    dx: torch.Tensor, dy: torch.Tensor,
+) -> torch.Tensor:
+    """x = a/σ_a of pixels: the resolved slope (world frame) at their flat-sea point along the line
+    of sight, a = s · ê with ê = −(dx, dy)/|(dx, dy)|, over its rms σ_a = √(êᵀ C ê), C = (var_x,
+    var_y, cov_xy) the resolved covariance. The ratio does not depend on the length of (dx, dy),
+    so it is taken unnormalized: x = −(s_x dx + s_y dy) / √(dᵀ C d). x = 0 where σ_a = 0."""
+    cxx, cyy, cxy = cov
+    q = cxx * dx * dx + 2.0 * cxy * dx * dy + cyy * dy * dy
+    ok = q > 0
+    return torch.where(ok, -(slope_x * dx + slope_y * dy) * torch.rsqrt(torch.where(ok, q, torch.ones_like(q))),
+                       torch.zeros_like(q))
+
+
 def pixel_resolved_slope(
     slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor],
     dx: torch.Tensor, dy: torch.Tensor,
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """(x = a/σ_a, σ_a², κ_r) of pixels from the resolved slope (world frame) at their flat-sea
     point, its covariance (var_x, var_y, cov_xy) and the world components dx, dy of the rays
-    (the line of sight to the sensor is −(dx, dy) horizontally). x = 0 where σ_a = 0."""
+    (the line of sight to the sensor is −(dx, dy) horizontally): x from :func:`resolved_quantile`,
+    σ_a² and κ_r from :func:`along_view`. x = 0 where σ_a = 0."""
     inv = torch.rsqrt((dx * dx + dy * dy).clamp_min(1e-30))
-    ex, ey = -dx * inv, -dy * inv
-    var_a, kappa = along_view(cov, ex, ey)
-    ok = var_a > 0
-    a = slope_x * ex + slope_y * ey
-    x = torch.where(ok, a * torch.rsqrt(torch.where(ok, var_a, torch.ones_like(var_a))), torch.zeros_like(a))
-    return x, var_a, kappa
+    var_a, kappa = along_view(cov, -dx * inv, -dy * inv)
+    return resolved_quantile(slope_x, slope_y, cov, dx, dy), var_a, kappa
 
 
 def footprint(range_m: torch.Tensor, cos_t: torch.Tensor, ifov: torch.Tensor) -> torch.Tensor:
@@ -434,7 +447,7 @@ class TextureTable:
         cov_rows = torch.stack(row_stats, 1)[..., None]  # (b, 3 (+1 with crest), rows, 1)
         grid = torch.stack([torch.zeros_like(gy), gy], -1)
         cov = F.grid_sample(cov_rows, grid, mode="bilinear", padding_mode="border", align_corners=True)
-        x, _, _ = pixel_resolved_slope(smp["slope_x"], smp["slope_y"], (cov[:, 0], cov[:, 1], cov[:, 2]), dx, dy)
+        x = resolved_quantile(smp["slope_x"], smp["slope_y"], (cov[:, 0], cov[:, 1], cov[:, 2]), dx, dy)
         # trilinear in (x, ζ, azimuth) as two bilinear reads of the slices of x that hold the pixel
         # (side by side along the width: column i · n_az + azimuth index) and a lerp between them;
         # border values beyond each axis, as a 3-D grid_sample (whose CPU kernel costs ~3x more)
