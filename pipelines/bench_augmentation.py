@@ -4,11 +4,14 @@ training step; the dataset generator's scaling with DataLoader workers.
 
 1. 8×512×640 float32 batches, timed in one run, for 1 and 2 torch threads, each without and with a
    competing busy-loop process (``python -c "while True: pass"``, started here and stopped at the
-   end of its block): the renderer alone (radiance), ``SensorModel.typical_lwir()`` alone (one
-   batched call, each image's noise from its own seed, as ``RandomSeaBackground`` runs it), the
-   same sensor image by image (how it ran before), and ``RandomSeaBackground`` with the sensor in
-   replace and composite mode. Variants are timed in turn within each repeat (so that a change of
-   load hits them alike); medians of ``--repeats``; ratios against the renderer of the same block.
+   end of its block): the renderer alone (radiance; also on the batch's first 2 images, one
+   chunk of the renderer), ``SensorModel.typical_lwir()`` alone (one batched call, each image's
+   noise from its own seed, as ``RandomSeaBackground`` runs it), the same sensor image by image
+   (how it ran before), and ``RandomSeaBackground`` with the sensor in replace and composite mode
+   (the example's augmentation: three atmospheres, so three renders of one chunk each). Variants and
+   thread counts are timed in turn within each repeat (so that a change of load hits them alike, and
+   the thread counts are compared within one run), after ``WARMUP`` calls of each; medians of
+   ``--repeats``; ratios against the renderer of the same thread count and load.
 2. The example training loop (``examples/train_segmentation.py``): median augmentation time and
    net step time per step, and the share of a step that sea generation costs, at the example's
    size (128×160) and at 512×640.
@@ -44,20 +47,29 @@ from roughsea_torch.sensor import SensorModel  # noqa: E402
 from train_segmentation import make_augmentation, ship_chips, train  # noqa: E402
 
 
-def median_times(fns: dict, repeats: int, sync=lambda: None) -> dict:
-    """Median time [s] of each callable, timed in turn within each repeat (after one warm-up
-    call each), so that a change of machine load hits every variant alike."""
-    ts = {name: [] for name in fns}
-    for fn in fns.values():
-        fn()
-        sync()
+WARMUP = 2  # calls of each stage at each thread count before timing
+
+
+def median_times(fns: dict, repeats: int, sync=lambda: None, threads=(1, 2)) -> dict:
+    """Median time [s] of each callable at each thread count, {threads: {name: s}}: the variants and
+    thread counts timed in turn within each repeat, after ``WARMUP`` calls each, so that a change
+    of machine load hits every variant alike."""
+    ts = {n: {name: [] for name in fns} for n in threads}
+    for n in threads:
+        torch.set_num_threads(n)
+        for fn in fns.values():
+            for _ in range(WARMUP):
+                fn()
+                sync()
     for _ in range(repeats):
-        for name, fn in fns.items():
-            t0 = time.perf_counter()
-            fn()
-            sync()
-            ts[name].append(time.perf_counter() - t0)
-    return {name: statistics.median(v) for name, v in ts.items()}
+        for n in threads:
+            torch.set_num_threads(n)
+            for name, fn in fns.items():
+                t0 = time.perf_counter()
+                fn()
+                sync()
+                ts[n][name].append(time.perf_counter() - t0)
+    return {n: {name: statistics.median(v) for name, v in t.items()} for n, t in ts.items()}
 
 
 def busy_process() -> subprocess.Popen:
@@ -116,8 +128,10 @@ def main() -> None:
         for i, s in enumerate(seeds):
             sensor(L[i : i + 1], generator=torch.Generator().manual_seed(int(s)))
 
+    small = {k: v[:2] for k, v in params.items()}  # two images: one chunk of the renderer
     stages = {
         "renderer only (radiance)": lambda: render_parameters(params, H, W, sampler.atmospheres, device=dev),
+        "renderer only, 2 images (one chunk)": lambda: render_parameters(small, H, W, sampler.atmospheres, device=dev),
         "sensor model only (batched)": sensor_batched,
         "sensor model only, image by image (as before)": sensor_looped,
         "RandomSeaBackground + sensor, replace": lambda: aug(x, generator=g),
@@ -129,10 +143,10 @@ def main() -> None:
         for loaded in (False, True):
             busy = busy_process() if loaded else None
             try:
+                load0 = os.getloadavg()[0]
+                times = median_times(stages, a.repeats, sync)
                 for threads in (1, 2):
-                    torch.set_num_threads(threads)
-                    load0 = os.getloadavg()[0]
-                    blocks.append((threads, loaded, median_times(stages, a.repeats, sync)))
+                    blocks.append((threads, loaded, times[threads]))
                     loads.append((load0, os.getloadavg()[0]))
                     print(blocks[-1], flush=True)
             finally:
@@ -141,8 +155,9 @@ def main() -> None:
                     busy.wait()
     torch.set_num_threads(threads0)
     lines += [f"## 1. Sensor and augmentation against the renderer, {B}×{H}×{W} float32 batches on {a.device}", "",
-              "Each block is timed in one run: its stages in turn within each repeat, medians of "
-              f"{a.repeats}. *Competing process*: a busy loop (`python -c \"while True: pass\"`) running beside "
+              "Each load is timed in one run: its stages and both thread counts in turn within each repeat, "
+              f"after {WARMUP} warm-up calls of each, medians of {a.repeats}. *Competing process*: a busy loop "
+              "(`python -c \"while True: pass\"`) running beside "
               "the benchmark.", "",
               f"The load average column is the machine's 1-minute load before → after the block ({os.cpu_count()} cores; "
               "other users' jobs count): far above 1 per core, absolute times are inflated and only the ratios "
