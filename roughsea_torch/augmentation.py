@@ -44,6 +44,7 @@ from typing import Any, Sequence
 import torch
 from kornia.augmentation import IntensityAugmentationBase2D
 
+from ._parallel import one_thread
 from ._validation import check_finite_range
 from .expectation import Quadrature
 from .geometry import EARTH_RADIUS_M, make_camera
@@ -445,19 +446,22 @@ def _render_frames(
 
             sun = dict(sun_zenith=((90.0 - g("sun_elevation_deg")) * (math.pi / 180.0)).to(dtype=dtype, device=device),
                        sun_azimuth=(g("sun_azimuth_deg") * (math.pi / 180.0)).to(dtype=dtype, device=device))
-        scene = SeaScene(
+        # the scene and the cameras on one intra-op thread: their many small operations gain little from a
+        # second idle core and stall beside a busy process (roughsea_torch._parallel); the render's own
+        # chunks of pixels still spread over the caller's threads
+        scene = one_thread(lambda: SeaScene(
             wind_speed=f("wind_speed"), anisotropic=anisotropic, wind_direction=f("wind_direction_deg") * (math.pi / 180.0),
             sea_temperature=f("sea_temperature"), air_temperature=f("air_temperature"), band=band,
             sky=atmospheres[a], path=None if path else False,
             seed=[int(s) for s in params["wave_seed"][idx.to(params["wave_seed"].device)].tolist()] if tex else None,
             **sun,
-        )
+        ), device)
         pose = {name: f(name, frames) for name in ("pitch_deg", "roll_deg", "altitude_m", "time_s")}
         for t in range(T):
-            cams = make_camera(
+            cams = one_thread(lambda: make_camera(
                 height, width, hfov_deg=f("hfov_deg"), altitude_m=pose["altitude_m"][:, t], pitch_deg=pose["pitch_deg"][:, t],
                 yaw_deg=f("yaw_deg"), roll_deg=pose["roll_deg"][:, t], dtype=dtype, device=device,
-            )
+            ), device)
             frame_scene = scene
             if tex:
                 frame_scene = copy.copy(scene)  # shares the sky tables and the wave-field cache
@@ -794,7 +798,8 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
             sub, H, W, self.sampler.atmospheres, band=self.band, anisotropic=self.anisotropic, dtype=dtype,
             device=input.device, table=self.table, quadrature=self.quadrature, path=self.path,
         )
-        L = self._finish(L, input[idx], sub["noise_seed"].tolist()).to(input.dtype)
+        # compositing and the sensor on one intra-op thread (as the scenes above)
+        L = one_thread(lambda: self._finish(L, input[idx], sub["noise_seed"].tolist()), input.device).to(input.dtype)
         if self.mode == "composite":
             out[idx, :1] = L
         else:
@@ -979,8 +984,9 @@ class RandomSeaClip(_Seas, torch.nn.Module):
             L = _render_frames(sub, frames, H, W, self.sampler.atmospheres, self.band, self.anisotropic, x.dtype,
                                x.device, self.table, self.quadrature, EARTH_RADIUS_M, self.path)
             n = idx.numel()
-            L = self._finish(L.reshape(n * T, 1, H, W), x[idx].reshape(n * T, C, H, W),
-                             frames["noise_seed"].reshape(-1).tolist()).to(x.dtype).reshape(n, T, 1, H, W)
+            L = one_thread(lambda: self._finish(L.reshape(n * T, 1, H, W), x[idx].reshape(n * T, C, H, W),  # as above
+                                                frames["noise_seed"].reshape(-1).tolist()), x.device)
+            L = L.to(x.dtype).reshape(n, T, 1, H, W)
             if self.mode == "composite":
                 out[idx, :, :1] = L
             else:

@@ -3,6 +3,7 @@ count, the caller's thread settings and autograd mode respected."""
 
 from __future__ import annotations
 
+import sys
 import threading
 
 import pytest
@@ -85,3 +86,58 @@ def test_sensor_runs_on_one_thread_and_restores_the_setting():
         assert torch.get_num_threads() == 2
     finally:
         torch.set_num_threads(before)
+
+
+def test_a_lone_chunk_runs_on_one_thread_more_chunks_on_the_workers(two_threads, monkeypatch):
+    """With 2 threads, render() spreads two chunks over the worker threads (one intra-op thread each),
+    runs a lone chunk on the calling thread with one intra-op thread (on shared cores a second one
+    slows its many small operations down), and restores the caller's setting."""
+    from roughsea_torch import _parallel as P
+
+    seen = []
+    map_chunks = P.map_chunks
+
+    def spy_map(fn, items, device):
+        def wrapped(x):
+            seen.append((threading.current_thread().name, torch.get_num_threads()))
+            return fn(x)
+        return map_chunks(wrapped, items, device)
+
+    monkeypatch.setattr(sys.modules["roughsea_torch.render"], "map_chunks", spy_map)
+    wind = torch.tensor([3.0, 6.0, 9.0, 12.0])
+    two = rs.render(_cams(), _scene(wind), chunk=2)
+    assert len(seen) == 2 and all(name.startswith("roughsea") and n == 1 for name, n in seen)
+    assert torch.get_num_threads() == 2
+    seen.clear()
+    one = rs.render(_cams(), _scene(wind), chunk=4)
+    assert seen == [(threading.current_thread().name, 1)] and torch.get_num_threads() == 2
+    assert torch.equal(one, two)
+
+
+def test_augmentation_builds_scenes_and_composites_on_one_thread(two_threads, monkeypatch):
+    """RandomSeaBackground builds its scenes and composites (with the sensor) on one intra-op thread,
+    and restores the caller's setting (also when a stage raises)."""
+    from roughsea_torch import augmentation as A
+
+    seen = {"scene": [], "finish": []}
+    finish, scene_init = A._Seas._finish, A.SeaScene.__init__
+
+    def spy_finish(self, *a, **k):
+        seen["finish"].append(torch.get_num_threads())
+        if len(seen["finish"]) > 1:
+            raise RuntimeError("boom")
+        return finish(self, *a, **k)
+
+    def spy_scene(self, *a, **k):
+        seen["scene"].append(torch.get_num_threads())
+        return scene_init(self, *a, **k)
+
+    monkeypatch.setattr(A._Seas, "_finish", spy_finish)
+    monkeypatch.setattr(A.SeaScene, "__init__", spy_scene)
+    aug = rs.RandomSeaBackground(texture=False, output="brightness_temperature")
+    aug(torch.zeros(2, 1, 12, 16), generator=torch.Generator().manual_seed(0))
+    assert seen["finish"] == [1] and seen["scene"] and set(seen["scene"]) == {1}
+    assert torch.get_num_threads() == 2
+    with pytest.raises(RuntimeError, match="boom"):
+        aug(torch.zeros(2, 1, 12, 16))
+    assert seen["finish"] == [1, 1] and torch.get_num_threads() == 2
