@@ -18,16 +18,17 @@ time may take the workers' setting of 1 (torch keeps the last value set as the d
 threads), which the workers restore when their chunk ends.
 
 A lone chunk on one intra-op thread, and :func:`one_thread` for the work around the chunks that is
-made of many small operations (an augmentation's scenes, cameras and compositing). Measured on 2
-cores, 512×640 float32, 1 and 2 threads alternated (``pipelines/bench_augmentation.py``): with
-torch's second intra-op thread on such work, renders of 1–3 images (one chunk) ran 1.1–1.27×
-faster than on one thread on an idle machine but 0.54–0.72× as fast beside a busy process, and
-the example's compositing augmentation (8 images in three atmosphere groups, one chunk each)
-0.56–0.76× as fast; on one intra-op thread they run at 0.97–1.02× of one thread's speed in both
-settings. Hundreds of parallel regions each wait for a thread that the other process has
-descheduled, which a gain of at most 1.27× on an idle machine does not pay for. (A render's own
-preparation is left at the caller's setting: on one intra-op thread it made the workers' chunks
-that follow 1.1× slower on an idle machine, for a reason not found, and it takes under 2 ms.)
+made of many small operations (an augmentation's scenes, cameras and compositing). Measured with
+``pipelines/bench_augmentation.py`` (2 cores, 512×640 float32, 1 and 2 threads alternated): with
+torch's second intra-op thread on such work, a render of 2 images (one chunk) ran 1.22× faster
+than on one thread on an idle machine but 0.65× as fast beside a busy process, and the example's
+compositing augmentation (8 images in three atmosphere groups, one chunk each) 1.16× and 0.63×;
+now 0.99× and 0.96×, and 1.10× and 0.96× (``docs/bench_augmentation_before_70b4f89.md``,
+``docs/bench_augmentation.md``). Hundreds of parallel regions each wait for a thread that the
+other process has descheduled. A render of one chunk runs on one intra-op thread from start to
+end (:func:`~roughsea_torch.render.render`). A render of several chunks leaves its own
+preparation (under 2 ms) at the caller's setting: on one intra-op thread it made the workers'
+chunks that followed take 1.1× as long on an idle machine, for a reason not found.
 """
 
 from __future__ import annotations

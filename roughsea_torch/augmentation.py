@@ -44,13 +44,13 @@ from typing import Any, Sequence
 import torch
 from kornia.augmentation import IntensityAugmentationBase2D
 
-from ._parallel import one_thread
+from ._parallel import map_chunks, one_thread
 from ._validation import check_finite_range
 from .expectation import Quadrature
 from .geometry import EARTH_RADIUS_M, make_camera
 from .motion import PlatformMotion
 from .radiometry import LWIR, as_band, band_radiance, brightness_temperature
-from .render import SeaScene, TableSize, render
+from .render import DEFAULT_CHUNK, SeaScene, TableSize, render
 from .sensor import SensorModel
 
 __all__ = [
@@ -420,7 +420,11 @@ def _render_frames(
 ) -> torch.Tensor:
     """(B, T, 1, H, W): frame t of image b from the fields of ``params`` (B,), with pose and time
     from ``frames`` (B, T). Images are grouped by atmosphere and by textured or not; a group's
-    scene is built once and its wave fields reused from frame to frame."""
+    scene is built once and its wave fields reused from frame to frame. Where every render is one
+    chunk of the renderer (expectation images, at most ``render.DEFAULT_CHUNK`` of them) and there
+    are several, the renders themselves are spread over the worker threads
+    (:func:`~roughsea_torch._parallel.map_chunks`; without it each would run alone on the calling
+    thread); no gradient may flow then, and the images are the same either way."""
     B, T = frames["time_s"].shape
     out = torch.empty(B, T, 1, height, width, dtype=dtype, device=device)
     atm = params["atmosphere"].cpu()
@@ -432,6 +436,7 @@ def _render_frames(
     if "is_day" in params:  # a draw with daytime > 0: the sun in the sky of the day images
         day = params["is_day"].detach().cpu().to(torch.bool)
     key = atm * 4 + textured.to(atm.dtype) * 2 + day.to(atm.dtype)
+    jobs = []  # (images, frame, camera, scene, whether the render is one chunk)
     for k in torch.unique(key).tolist():
         a, tex, sunny = k // 4, bool((k // 2) % 2), bool(k % 2)
         idx = (key == k).nonzero()[:, 0]
@@ -447,8 +452,8 @@ def _render_frames(
             sun = dict(sun_zenith=((90.0 - g("sun_elevation_deg")) * (math.pi / 180.0)).to(dtype=dtype, device=device),
                        sun_azimuth=(g("sun_azimuth_deg") * (math.pi / 180.0)).to(dtype=dtype, device=device))
         # the scene and the cameras on one intra-op thread: their many small operations gain little from a
-        # second idle core and stall beside a busy process (roughsea_torch._parallel); the render's own
-        # chunks of pixels still spread over the caller's threads
+        # second idle core and stall beside a busy process (roughsea_torch._parallel); the renders' chunks
+        # of pixels still spread over the caller's threads
         scene = one_thread(lambda: SeaScene(
             wind_speed=f("wind_speed"), anisotropic=anisotropic, wind_direction=f("wind_direction_deg") * (math.pi / 180.0),
             sea_temperature=f("sea_temperature"), air_temperature=f("air_temperature"), band=band,
@@ -457,17 +462,29 @@ def _render_frames(
             **sun,
         ), device)
         pose = {name: f(name, frames) for name in ("pitch_deg", "roll_deg", "altitude_m", "time_s")}
+        cam = dict(hfov_deg=f("hfov_deg"), yaw_deg=f("yaw_deg"))
         for t in range(T):
-            cams = one_thread(lambda: make_camera(
-                height, width, hfov_deg=f("hfov_deg"), altitude_m=pose["altitude_m"][:, t], pitch_deg=pose["pitch_deg"][:, t],
-                yaw_deg=f("yaw_deg"), roll_deg=pose["roll_deg"][:, t], dtype=dtype, device=device,
-            ), device)
             frame_scene = scene
             if tex:
                 frame_scene = copy.copy(scene)  # shares the sky tables and the wave-field cache
                 frame_scene.time_s = pose["time_s"][:, t]
-            img = render(cams, frame_scene, earth_radius_m=earth_radius_m, table=table, quadrature=quadrature)
-            out[idx.to(out.device), t] = img
+            cam_t = dict(cam, altitude_m=pose["altitude_m"][:, t], pitch_deg=pose["pitch_deg"][:, t],
+                         roll_deg=pose["roll_deg"][:, t])
+            jobs.append((idx, t, cam_t, frame_scene, not tex and idx.numel() <= DEFAULT_CHUNK))
+
+    def run(job: tuple) -> None:
+        idx, t, cam_t, frame_scene, _ = job
+        cams = one_thread(lambda: make_camera(height, width, **cam_t, dtype=dtype, device=device), device)
+        out[idx.to(out.device), t] = render(cams, frame_scene, earth_radius_m=earth_radius_m, table=table,
+                                            quadrature=quadrature)
+
+    grad = torch.is_grad_enabled() and any(isinstance(v, torch.Tensor) and v.requires_grad
+                                           for v in (*params.values(), *frames.values()))
+    if len(jobs) > 1 and all(job[-1] for job in jobs) and not grad:
+        map_chunks(run, jobs, device)
+    else:
+        for job in jobs:
+            run(job)
     return out
 
 

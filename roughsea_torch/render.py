@@ -35,7 +35,7 @@ import torch
 import torch.nn.functional as F
 from kornia.geometry.camera import PinholeCamera
 
-from ._parallel import map_chunks
+from ._parallel import map_chunks, one_thread
 from ._pixels import table_grid
 from ._validation import check_finite_range, per_batch
 from .expectation import Quadrature, _reflection_terms, apparent_radiance
@@ -47,6 +47,8 @@ from .sky import ConstantSky, TabulatedSky, as_sky, select_sky
 from .slopes import SlopeStatistics
 
 __all__ = ["SeaScene", "render", "SeaRenderer", "TableSize"]
+
+DEFAULT_CHUNK = 4  # images per chunk of an expectation render (render's ``chunk``; textured scenes: 1)
 
 
 class SeaScene:
@@ -888,10 +890,38 @@ def render(
         (B, 1, H, W) tensor in the cameras' dtype and device; differentiable with respect to every
         tensor of the scene and of the cameras' pose.
     """
+    # a render of one chunk (a small batch) on one intra-op thread, its preparation included: with
+    # torch's second thread its many small operations ran 0.5-0.9x as fast beside a busy process
+    # (roughsea_torch._parallel); larger batches spread their chunks over worker threads instead
+    def call() -> torch.Tensor:
+        return _render(cameras, scene, earth_radius_m=earth_radius_m, method=method, output=output, table=table,
+                       quadrature=quadrature, geometry=geometry, chunk=chunk)
+
+    ref = geometry.cos_view_zenith if geometry is not None else getattr(cameras, "intrinsics", None)
+    per_chunk = (chunk if isinstance(chunk, int) and chunk > 0 else 1 if getattr(scene, "seed", None) is not None
+                 else DEFAULT_CHUNK)
+    if method == "table" and isinstance(ref, torch.Tensor) and ref.ndim > 0 and ref.shape[0] <= per_chunk:
+        return one_thread(call, ref.device)
+    return call()
+
+
+def _render(
+    cameras: PinholeCamera,
+    scene: SeaScene,
+    *,
+    earth_radius_m: float,
+    method: str,
+    output: str,
+    table: TableSize,
+    quadrature: Quadrature | None,
+    geometry: ViewGeometry | None,
+    chunk: int | None,
+) -> torch.Tensor:
+    """:func:`render`'s body."""
     if method not in ("table", "direct"):
         raise ValueError(f"method must be 'table' or 'direct'; got {method!r}")
     if chunk is None:
-        chunk = 1 if scene.seed is not None else 4
+        chunk = 1 if scene.seed is not None else DEFAULT_CHUNK
     if output not in ("radiance", "brightness_temperature"):
         raise ValueError(f"output must be 'radiance' or 'brightness_temperature'; got {output!r}")
     if geometry is not None:

@@ -90,8 +90,9 @@ def test_sensor_runs_on_one_thread_and_restores_the_setting():
 
 def test_a_lone_chunk_runs_on_one_thread_more_chunks_on_the_workers(two_threads, monkeypatch):
     """With 2 threads, render() spreads two chunks over the worker threads (one intra-op thread each),
-    runs a lone chunk on the calling thread with one intra-op thread (on shared cores a second one
-    slows its many small operations down), and restores the caller's setting."""
+    runs a render of one chunk, its preparation included, on the calling thread with one intra-op
+    thread (on shared cores a second one slows its many small operations down), and restores the
+    caller's setting."""
     from roughsea_torch import _parallel as P
 
     seen = []
@@ -103,14 +104,23 @@ def test_a_lone_chunk_runs_on_one_thread_more_chunks_on_the_workers(two_threads,
             return fn(x)
         return map_chunks(wrapped, items, device)
 
+    setup = []
+    resolved = rs.SeaScene.resolved
+
+    def spy_setup(self, *a, **k):
+        setup.append(torch.get_num_threads())
+        return resolved(self, *a, **k)
+
     monkeypatch.setattr(sys.modules["roughsea_torch.render"], "map_chunks", spy_map)
+    monkeypatch.setattr(rs.SeaScene, "resolved", spy_setup)
     wind = torch.tensor([3.0, 6.0, 9.0, 12.0])
     two = rs.render(_cams(), _scene(wind), chunk=2)
     assert len(seen) == 2 and all(name.startswith("roughsea") and n == 1 for name, n in seen)
-    assert torch.get_num_threads() == 2
+    assert setup == [2] and torch.get_num_threads() == 2  # the preparation at the caller's setting
     seen.clear()
-    one = rs.render(_cams(), _scene(wind), chunk=4)
-    assert seen == [(threading.current_thread().name, 1)] and torch.get_num_threads() == 2
+    setup.clear()
+    one = rs.render(_cams(), _scene(wind), chunk=4)  # one chunk: all of it on one intra-op thread
+    assert seen == [(threading.current_thread().name, 1)] and setup == [1] and torch.get_num_threads() == 2
     assert torch.equal(one, two)
 
 
@@ -141,3 +151,37 @@ def test_augmentation_builds_scenes_and_composites_on_one_thread(two_threads, mo
     with pytest.raises(RuntimeError, match="boom"):
         aug(torch.zeros(2, 1, 12, 16))
     assert seen["finish"] == [1, 1] and torch.get_num_threads() == 2
+
+
+def test_atmosphere_groups_render_on_the_workers_and_match_one_thread(two_threads, monkeypatch):
+    """Several renders of one chunk each (images in three atmosphere groups) run side by side on the
+    worker threads, with the same images as on one thread (bitwise); with a gradient wanted they
+    run in turn on the calling thread, and the gradient matches one thread's."""
+    from roughsea_torch import augmentation as A
+
+    s = rs.SceneSampler(atmospheres=["midlatitude_summer", "tropical", "us_standard"])
+    p = s.sample(6, torch.Generator().manual_seed(3))
+    p["atmosphere"] = torch.tensor([0, 1, 2, 0, 1, 2])
+    where = []
+    render = A.render
+
+    def spy(*a, **k):
+        where.append(threading.current_thread().name)
+        return render(*a, **k)
+
+    monkeypatch.setattr(A, "render", spy)
+    two = A.render_parameters(p, 12, 16, s.atmospheres, dtype=torch.float64)
+    assert len(where) == 3 and all(name.startswith("roughsea") for name in where)
+    torch.set_num_threads(1)
+    one = A.render_parameters(p, 12, 16, s.atmospheres, dtype=torch.float64)
+    assert torch.equal(one, two)
+    torch.set_num_threads(2)
+    where.clear()
+    wind = p["wind_speed"].clone().double().requires_grad_(True)
+    (g2,) = torch.autograd.grad(A.render_parameters(dict(p, wind_speed=wind), 12, 16, s.atmospheres,
+                                                    dtype=torch.float64).sum(), wind)
+    assert where == [threading.current_thread().name] * 3
+    torch.set_num_threads(1)
+    (g1,) = torch.autograd.grad(A.render_parameters(dict(p, wind_speed=wind), 12, 16, s.atmospheres,
+                                                    dtype=torch.float64).sum(), wind)
+    assert torch.equal(g1, g2) and bool((g1 != 0).all())
