@@ -6,8 +6,9 @@ float32, each with its own wind, direction, sea temperature and camera pose (alt
 pitch −8…−1°; ``bench_render.batch``), rendered as expectation images and as textured realizations
 (one seed per image), with 1 and 2 torch threads. Median of ``--repeats`` runs; the ratio is
 textured / expectation timed in the same run. Then peak resident memory of each (separate
-processes, sampled every millisecond over the resident memory just before the render), against
-the output's size, and where the textured render's time goes (1 thread).
+processes, sampled every millisecond over the resident memory just before the render; the batch
+of 16 and one of 64), against the output's size, and where the textured render's time goes (1
+thread).
 
 Usage:
     python pipelines/bench_texture.py [--repeats 5] [--out docs]
@@ -40,13 +41,15 @@ def scenes(b: int = B):
     return cams, rs.SeaScene(**sc), rs.SeaScene(**sc, seed=list(range(b)), time_s=12.5)
 
 
-def memory_child(kind: str) -> None:
-    cam, sc = batch(B)
+def memory_child(spec: str) -> None:
+    kind, b = spec.split(":")
+    b = int(b)
+    cam, sc = batch(b)
     small = rs.make_camera(8, 8, **{k: v[:1] for k, v in cam.items()})
     extra = dict(seed=[0]) if kind == "textured" else {}
     rs.render(small, rs.SeaScene(**{k: v[:1] for k, v in sc.items()}, **extra))
     cams = rs.make_camera(H, W, **cam)
-    scene = rs.SeaScene(**sc, **(dict(seed=list(range(B)), time_s=12.5) if kind == "textured" else {}))
+    scene = rs.SeaScene(**sc, **(dict(seed=list(range(b)), time_s=12.5) if kind == "textured" else {}))
     img, peak = peak_memory(lambda: rs.render(cams, scene))
     print(json.dumps({"peak_mb": peak, "output_mb": img.numel() * img.element_size() / 2**20}))
 
@@ -119,13 +122,16 @@ def main() -> None:
         t_d = med(lambda: rs.render(cams, day), args.repeats)
         lines.append(f"| {name} | {t_n:.3f} | {t_d:.3f} | {t_d / t_n:.2f} |")
         print(lines[-1], file=sys.stderr)
-    lines += ["", "Peak resident memory over the process's before the render (separate processes):", "",
-              "| render | peak [MB] | output [MB] | peak / output |", "|---|---:|---:|---:|"]
-    for kind in ("expectation", "textured"):
-        out = subprocess.run([sys.executable, __file__, "--memory-child", kind], capture_output=True, text=True,
-                             check=True, env=dict(os.environ, OMP_NUM_THREADS="2"))
-        m = json.loads(out.stdout.strip().splitlines()[-1])
-        lines.append(f"| {kind} | {m['peak_mb']:.0f} | {m['output_mb']:.0f} | {m['peak_mb'] / m['output_mb']:.1f} |")
+    lines += ["", "Peak resident memory over the process's before the render (separate processes, 2 threads; a batch "
+              "of 64 as well, where the fixed part, tables and per-thread workspaces, weighs less):", "",
+              "| render | images | peak [MB] | output [MB] | peak / output |", "|---|---:|---:|---:|---:|"]
+    for b in (B, 64):
+        for kind in ("expectation", "textured"):
+            out = subprocess.run([sys.executable, __file__, "--memory-child", f"{kind}:{b}"], capture_output=True,
+                                 text=True, check=True, env=dict(os.environ, OMP_NUM_THREADS="2"))
+            m = json.loads(out.stdout.strip().splitlines()[-1])
+            lines.append(f"| {kind} | {b} | {m['peak_mb']:.0f} | {m['output_mb']:.0f} | {m['peak_mb'] / m['output_mb']:.1f} |")
+            print(lines[-1], file=sys.stderr)
     torch.set_num_threads(1)
     lines += ["", "Where the textured render's time goes (1 thread, profiler CPU totals):", "", "| part | s |", "|---|---:|"]
     lines += [f"| {k} | {v:.3f} |" for k, v in stages(cams, tex_scene)]
