@@ -98,13 +98,8 @@ NOTES[("geometry", "L141 1.0")] = ("equivalent: clamp(cos, -1, 1.01) before acos
 NOTES[("sky", "L108 2")] = ("equivalent: a bucket's first interval is clamped one interval lower at the table's "
                             "end; the compare with the next node then moves the query into the right interval "
                             "(tests/test_torch_core.py compares the lookup with scipy's PCHIP).")
-NOTES[("_parallel", 'L54 dev.type != "cpu"')] = (
-    "equivalent by design: on the CPU the chunks then run in order on the calling thread, which gives "
-    "the same results (tests/test_parallel.py checks 1 vs 2 threads bitwise); only speed under load changes.")
-NOTES[("_parallel", "L54 n <= 1")] = ("equivalent: with one thread the chunks run on a pool of one worker "
-                                      "instead of the calling thread; same results and thread settings.")
-NOTES[("_parallel", "L54 len(items) <= 1")] = ("equivalent: a single chunk runs on a worker instead of the "
-                                               "calling thread; same results.")
+NOTES[("_parallel", "L96 n <= 1")] = ("equivalent: with one thread, one_thread sets torch's thread count to 1 "
+                                      "and restores it to 1 instead of returning at once; same results and settings.")
 NOTES[("expectation", "L269 A * sqrt_1mB2")] = (
     "accuracy only: it moves the sky disc's outer panel limits where the Gaussian window (7.5σ) ends "
     "inside the disc, narrowing the window to about 5σ near nadir; measured over W = 0, 5, 20 m/s "
