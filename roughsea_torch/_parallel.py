@@ -12,7 +12,7 @@ chunks. The chunks are the same whatever the thread count, so results do not dep
 Used only on the CPU, with torch's OpenMP backend, when ``torch.get_num_threads() > 1`` and there
 are at least two chunks; a lone chunk runs on the calling thread with one intra-op thread, and
 otherwise (CUDA, one thread) the chunks run in order on the calling thread. The workers take the
-caller's autograd mode. ``torch.set_num_threads`` is per thread under OpenMP (a worker's setting
+caller's autograd mode and CPU autocast. ``torch.set_num_threads`` is per thread under OpenMP (a worker's setting
 does not change the caller's); while a call runs, a thread that starts using torch for the first
 time may take the workers' setting of 1 (torch keeps the last value set as the default for new
 threads), which the workers restore when their chunk ends.
@@ -70,6 +70,10 @@ def map_chunks(fn: Callable[[Any], T], items: Sequence[Any], device: torch.devic
     if len(items) == 1:  # one chunk: on one intra-op thread (module docstring)
         return [one_thread(lambda: fn(items[0]), dev)]
     grad, inference = torch.is_grad_enabled(), torch.is_inference_mode_enabled()
+    # CPU autocast is per thread too: the workers take the caller's (else they would compute in float32
+    # what the caller's thread computes in bfloat16, and images would depend on the thread count)
+    autocast = torch.is_autocast_enabled("cpu")
+    autocast_dtype = torch.get_autocast_dtype("cpu")
 
     def run(x: Any) -> T:
         _local.worker = True
@@ -78,7 +82,8 @@ def map_chunks(fn: Callable[[Any], T], items: Sequence[Any], device: torch.devic
         torch.get_num_threads()
         torch.set_num_threads(1)
         try:
-            with torch.inference_mode(inference), torch.set_grad_enabled(grad):
+            with (torch.inference_mode(inference), torch.set_grad_enabled(grad),
+                  torch.autocast("cpu", dtype=autocast_dtype, enabled=autocast)):
                 return fn(x)
         finally:
             torch.set_num_threads(n)

@@ -424,7 +424,8 @@ def _render_frames(
     chunk of the renderer (expectation images, at most ``render.DEFAULT_CHUNK`` of them) and there
     are several, the renders themselves are spread over the worker threads
     (:func:`~roughsea_torch._parallel.map_chunks`; without it each would run alone on the calling
-    thread); no gradient may flow then, and the images are the same either way."""
+    thread); no gradient may flow then, and the images are the same either way (the workers take
+    the caller's CPU autocast too)."""
     B, T = frames["time_s"].shape
     out = torch.empty(B, T, 1, height, width, dtype=dtype, device=device)
     atm = params["atmosphere"].cpu()
@@ -452,8 +453,8 @@ def _render_frames(
             sun = dict(sun_zenith=((90.0 - g("sun_elevation_deg")) * (math.pi / 180.0)).to(dtype=dtype, device=device),
                        sun_azimuth=(g("sun_azimuth_deg") * (math.pi / 180.0)).to(dtype=dtype, device=device))
         # the scene and the cameras on one intra-op thread: their many small operations gain little from a
-        # second idle core and stall beside a busy process (roughsea_torch._parallel); the renders' chunks
-        # of pixels still spread over the caller's threads
+        # second idle core and stall beside a busy process (roughsea_torch._parallel); the renders themselves
+        # are spread below
         scene = one_thread(lambda: SeaScene(
             wind_speed=f("wind_speed"), anisotropic=anisotropic, wind_direction=f("wind_direction_deg") * (math.pi / 180.0),
             sea_temperature=f("sea_temperature"), air_temperature=f("air_temperature"), band=band,

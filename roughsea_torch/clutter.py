@@ -193,10 +193,12 @@ def resolved_quantile(
     """x = a/σ_a of pixels: the resolved slope (world frame) at their flat-sea point along the line
     of sight, a = s · ê with ê = −(dx, dy)/|(dx, dy)|, over its rms σ_a = √(êᵀ C ê), C = (var_x,
     var_y, cov_xy) the resolved covariance. The ratio does not depend on the length of (dx, dy),
-    so it is taken unnormalized: x = −(s_x dx + s_y dy) / √(dᵀ C d). x = 0 where σ_a = 0."""
+    so it is taken unnormalized: x = −(s_x dx + s_y dy) / √(dᵀ C d). x = 0 (and its gradient 0) where
+    σ_a² ≤ 1e-30 in float64, 1e-24 in float32 (rms slopes of 1e-15 and 1e-12: nothing resolved),
+    beyond which rsqrt's derivative q^(−3/2) would overflow."""
     cxx, cyy, cxy = cov
     q = cxx * dx * dx + 2.0 * cxy * dx * dy + cyy * dy * dy
-    ok = q > 0
+    ok = q > (1e-30 if q.dtype == torch.float64 else 1e-24) * (dx * dx + dy * dy)
     return torch.where(ok, -(slope_x * dx + slope_y * dy) * torch.rsqrt(torch.where(ok, q, torch.ones_like(q))),
                        torch.zeros_like(q))
 
@@ -208,7 +210,7 @@ def pixel_resolved_slope(
     """(x = a/σ_a, σ_a², κ_r) of pixels from the resolved slope (world frame) at their flat-sea
     point, its covariance (var_x, var_y, cov_xy) and the world components dx, dy of the rays
     (the line of sight to the sensor is −(dx, dy) horizontally): x from :func:`resolved_quantile`,
-    σ_a² and κ_r from :func:`along_view`. x = 0 where σ_a = 0."""
+    σ_a² and κ_r from :func:`along_view`. x = 0 where σ_a = 0 (:func:`resolved_quantile`'s threshold)."""
     inv = torch.rsqrt((dx * dx + dy * dy).clamp_min(1e-30))
     var_a, kappa = along_view(cov, -dx * inv, -dy * inv)
     return resolved_quantile(slope_x, slope_y, cov, dx, dy), var_a, kappa

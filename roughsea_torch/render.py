@@ -26,6 +26,7 @@ autograd graph when nothing requires grad; per-pixel temporaries for ``chunk`` i
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -49,6 +50,7 @@ from .slopes import SlopeStatistics
 __all__ = ["SeaScene", "render", "SeaRenderer", "TableSize"]
 
 DEFAULT_CHUNK = 4  # images per chunk of an expectation render (render's ``chunk``; textured scenes: 1)
+_CACHE_LOCK = threading.RLock()  # SeaScene's caches (skies, wave fields), filled from worker threads
 
 
 class SeaScene:
@@ -301,13 +303,16 @@ class SeaScene:
         if self.sun_zenith is None or self._sun is not None or self.atmosphere is None or self.aerosol is None:
             return None
         key = (self.atmosphere, self.aerosol, self.band)
-        if key not in self._day_skies:
-            from .daysky import load_scattered_sky
+        with _CACHE_LOCK:  # renders of one scene may run side by side (augmentation._render_frames)
+            sky = self._day_skies.get(key)
+            if sky is None:
+                from .daysky import load_scattered_sky
 
-            self._day_skies.clear()
-            self._day_skies[key] = load_scattered_sky(self.atmosphere, (self.band.lo, self.band.hi),
-                                                      aerosol=self.aerosol, response=self.band.response)
-        return self._day_skies[key]
+                sky = load_scattered_sky(self.atmosphere, (self.band.lo, self.band.hi), aerosol=self.aerosol,
+                                         response=self.band.response)
+                self._day_skies.clear()
+                self._day_skies[key] = sky
+        return sky
 
     @property
     def observer_sky(self) -> Any:
@@ -318,12 +323,15 @@ class SeaScene:
         if self.atmosphere is None or self.path is None or getattr(self.path, "name", None) != self.atmosphere:
             return None
         key = (self.atmosphere, self.band)
-        if key not in self._observer_skies:
-            from .atmosphere import load_observer_sky
+        with _CACHE_LOCK:
+            sky = self._observer_skies.get(key)
+            if sky is None:
+                from .atmosphere import load_observer_sky
 
-            self._observer_skies.clear()
-            self._observer_skies[key] = load_observer_sky(self.atmosphere, self.band, dtype=torch.float64)
-        return self._observer_skies[key]
+                sky = load_observer_sky(self.atmosphere, self.band, dtype=torch.float64)
+                self._observer_skies.clear()
+                self._observer_skies[key] = sky
+        return sky
 
     @property
     def batch_size(self) -> int:
@@ -369,9 +377,10 @@ class SeaScene:
         if wf is None or key[-1]:
             wf = WaveField(wind, seeds, wind_direction=wd, dtype=dtype, device=device, min_band_share=share)
             if not key[-1]:
-                if len(self._wave_fields) >= 64:
-                    self._wave_fields.pop(next(iter(self._wave_fields)))
-                self._wave_fields[key] = wf
+                with _CACHE_LOCK:  # chunks of a textured render fill it from worker threads
+                    if len(self._wave_fields) >= 64:
+                        self._wave_fields.pop(next(iter(self._wave_fields)))
+                    self._wave_fields[key] = wf
         return wf
 
     def resolved(self, B: int, dtype: torch.dtype, device: torch.device) -> dict[str, Any]:

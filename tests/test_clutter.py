@@ -334,3 +334,36 @@ def test_visible_slope_grid_error_against_a_finer_grid():
     err = (visible_slope(x, ct, st, sr, su) - visible_slope(x, ct, st, sr, su, nodes=16385)).abs() / sr[:, None]
     assert float(err.median()) < 1e-4
     assert float(err.max()) < 1e-3
+
+
+@pytest.mark.parametrize("dtype", [torch.float64, torch.float32])
+def test_resolved_quantile_is_the_normalized_slope_ratio(dtype):
+    """x = a/σ_a with a = s·ê, σ_a² = êᵀCê, ê = −(dx, dy)/|(dx, dy)| (the closed form, written out
+    here), for random slopes, covariances (correlated, anisotropic) and ray directions of any
+    length; x = 0 with a zero gradient where nothing is resolved (σ_a² of 1e-31 or 0, where
+    rsqrt's derivative would overflow)."""
+    from roughsea_torch.clutter import resolved_quantile
+
+    g = torch.Generator().manual_seed(7)
+    n = 2000
+    sx, sy = torch.randn(2, n, generator=g, dtype=torch.float64) * 0.1
+    a_ = torch.rand(n, generator=g, dtype=torch.float64) * 0.05 + 1e-4
+    b_ = torch.rand(n, generator=g, dtype=torch.float64) * 0.05 + 1e-4
+    r = (torch.rand(n, generator=g, dtype=torch.float64) * 2 - 1) * 0.95
+    cov = (a_, b_, r * torch.sqrt(a_ * b_))
+    ang = torch.rand(n, generator=g, dtype=torch.float64) * 2 * math.pi
+    length = 10.0 ** (torch.rand(n, generator=g, dtype=torch.float64) * 6 - 3)
+    dx, dy = length * torch.cos(ang), length * torch.sin(ang)
+    ex, ey = -torch.cos(ang), -torch.sin(ang)
+    want = (sx * ex + sy * ey) / torch.sqrt(cov[0] * ex * ex + 2 * cov[2] * ex * ey + cov[1] * ey * ey)
+    got = resolved_quantile(*(t.to(dtype) for t in (sx, sy)), tuple(c.to(dtype) for c in cov), dx.to(dtype), dy.to(dtype))
+    # float32: the inputs' own rounding, through covariances correlated up to |r| = 0.95
+    tol = 1e-12 if dtype == torch.float64 else 1e-5
+    assert float(((got.double() - want).abs() / (1.0 + want.abs())).max()) < tol
+    for v in (0.0, 1e-31):
+        c = torch.full((3,), v, dtype=dtype, requires_grad=True)
+        s_ = torch.tensor(1e-16, dtype=dtype, requires_grad=True)
+        x = resolved_quantile(s_, torch.zeros((), dtype=dtype), (c[0], c[1], c[2] * 0), torch.tensor(1.0, dtype=dtype),
+                              torch.tensor(0.5, dtype=dtype))
+        grads = torch.autograd.grad(x, (c, s_))
+        assert float(x.detach()) == 0.0 and all(bool((gr == 0).all()) for gr in grads)

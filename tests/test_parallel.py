@@ -125,8 +125,8 @@ def test_a_lone_chunk_runs_on_one_thread_more_chunks_on_the_workers(two_threads,
 
 
 def test_augmentation_builds_scenes_and_composites_on_one_thread(two_threads, monkeypatch):
-    """RandomSeaBackground builds its scenes and composites (with the sensor) on one intra-op thread,
-    and restores the caller's setting (also when a stage raises)."""
+    """RandomSeaBackground and RandomSeaClip build their scenes and cameras and composite (with the
+    sensor) on one intra-op thread, and restore the caller's setting (also when a stage raises)."""
     from roughsea_torch import augmentation as A
 
     seen = {"scene": [], "finish": []}
@@ -142,15 +142,30 @@ def test_augmentation_builds_scenes_and_composites_on_one_thread(two_threads, mo
         seen["scene"].append(torch.get_num_threads())
         return scene_init(self, *a, **k)
 
+    seen["camera"] = []
+    make_camera = A.make_camera
+
+    def spy_camera(*a, **k):
+        seen["camera"].append(torch.get_num_threads())
+        return make_camera(*a, **k)
+
     monkeypatch.setattr(A._Seas, "_finish", spy_finish)
     monkeypatch.setattr(A.SeaScene, "__init__", spy_scene)
+    monkeypatch.setattr(A, "make_camera", spy_camera)
     aug = rs.RandomSeaBackground(texture=False, output="brightness_temperature")
     aug(torch.zeros(2, 1, 12, 16), generator=torch.Generator().manual_seed(0))
-    assert seen["finish"] == [1] and seen["scene"] and set(seen["scene"]) == {1}
+    assert seen["finish"] == [1] and seen["scene"] and set(seen["scene"]) == {1} and set(seen["camera"]) == {1}
     assert torch.get_num_threads() == 2
     with pytest.raises(RuntimeError, match="boom"):
         aug(torch.zeros(2, 1, 12, 16))
     assert seen["finish"] == [1, 1] and torch.get_num_threads() == 2
+    # the clip augmentation alike (frame cameras, compositing)
+    seen["finish"].clear()
+    seen["camera"].clear()
+    rs.RandomSeaClip(texture=False, frame_rate=5.0, output="brightness_temperature")(
+        torch.zeros(1, 2, 1, 12, 16), generator=torch.Generator().manual_seed(1))
+    assert seen["finish"] == [1] and set(seen["camera"]) == {1} and len(seen["camera"]) == 2
+    assert torch.get_num_threads() == 2
 
 
 def test_atmosphere_groups_render_on_the_workers_and_match_one_thread(two_threads, monkeypatch):
@@ -185,3 +200,53 @@ def test_atmosphere_groups_render_on_the_workers_and_match_one_thread(two_thread
     (g1,) = torch.autograd.grad(A.render_parameters(dict(p, wind_speed=wind), 12, 16, s.atmospheres,
                                                     dtype=torch.float64).sum(), wind)
     assert torch.equal(g1, g2) and bool((g1 != 0).all())
+    # a group of 5 images (two chunks: the render spreads them itself) or textured groups (a chunk an
+    # image): the renders run in turn on the calling thread
+    torch.set_num_threads(2)
+    for atm, extra in (([0, 0, 0, 0, 0, 1], {}), ([0, 1, 2, 0, 1, 2], dict(wave_seed=torch.arange(6)))):
+        where.clear()
+        A.render_parameters(dict(p, atmosphere=torch.tensor(atm), **extra), 12, 16, s.atmospheres)
+        assert where == [threading.current_thread().name] * len(set(atm))
+
+
+def test_map_chunks_lone_chunk_and_autocast(two_threads):
+    """map_chunks runs a lone chunk on the calling thread with one intra-op thread, and the workers
+    take the caller's CPU autocast: a render under bfloat16 autocast is the same on 1 and 2 threads
+    (it differed by 0.28 W m-2 sr-1 before the workers took it)."""
+    from roughsea_torch._parallel import map_chunks
+
+    def probe(_):
+        return threading.current_thread().name, torch.get_num_threads(), torch.is_autocast_enabled("cpu")
+
+    assert map_chunks(probe, [0], "cpu") == [(threading.current_thread().name, 1, False)]
+    assert torch.get_num_threads() == 2
+    with torch.autocast("cpu", dtype=torch.bfloat16):
+        on_workers = map_chunks(probe, [0, 1], "cpu")
+        assert all(name.startswith("roughsea") and n == 1 and ac for name, n, ac in on_workers)
+        cams = rs.make_camera(24, 32, altitude_m=torch.tensor([10.0, 20.0, 50.0, 200.0]),
+                              pitch_deg=torch.tensor([-2.0, -4.0, -8.0, -1.0]))
+        two = rs.render(cams, _scene(torch.tensor([3.0, 6.0, 9.0, 12.0])), chunk=2)
+        torch.set_num_threads(1)
+        one = rs.render(cams, _scene(torch.tensor([3.0, 6.0, 9.0, 12.0])), chunk=2)
+    plain = rs.render(cams, _scene(torch.tensor([3.0, 6.0, 9.0, 12.0])), chunk=2)
+    assert torch.equal(one, two) and not torch.equal(one, plain)  # (autocast does change the numbers)
+
+
+def test_textured_render_of_two_images_uses_the_workers(two_threads, monkeypatch):
+    """A textured scene renders a chunk an image: two images are two chunks, on the workers (the
+    one-chunk path of render() must count the chunks of the scene's kind)."""
+    from roughsea_torch import _parallel as P
+
+    names = []
+    map_chunks = P.map_chunks
+
+    def spy_map(fn, items, device):
+        def wrapped(x):
+            names.append(threading.current_thread().name)
+            return fn(x)
+        return map_chunks(wrapped, items, device)
+
+    monkeypatch.setattr(sys.modules["roughsea_torch.render"], "map_chunks", spy_map)
+    cams = rs.make_camera(16, 20, altitude_m=20.0, pitch_deg=-6.0, batch_size=2)
+    rs.render(cams, rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, seed=[1, 2]))
+    assert len(names) >= 2 and all(n.startswith("roughsea") for n in names)
