@@ -159,9 +159,9 @@ def main() -> None:
               f"after {WARMUP} warm-up calls of each, medians of {a.repeats}. *Competing process*: a busy loop "
               "(`python -c \"while True: pass\"`) running beside "
               "the benchmark.", "",
-              f"The load average column is the machine's 1-minute load before → after the block ({os.cpu_count()} cores; "
-              "other users' jobs count): far above 1 per core, absolute times are inflated and only the ratios "
-              "within a block compare.", "",
+              f"The load average column is the machine's 1-minute load before → after the run of each load, both "
+              f"thread counts together ({os.cpu_count()} cores; other users' jobs count): far above 1 per core, "
+              "absolute times are inflated and only the ratios within a load compare.", "",
               "| threads | competing process | load average | stage | ms per batch | images/s | × renderer |",
               "|---:|---|---|---|---:|---:|---:|"]
     for (threads, loaded, times), (l0, l1) in zip(blocks, loads):
