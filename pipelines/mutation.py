@@ -98,7 +98,7 @@ NOTES[("geometry", "L141 1.0")] = ("equivalent: clamp(cos, -1, 1.01) before acos
 NOTES[("sky", "L108 2")] = ("equivalent: a bucket's first interval is clamped one interval lower at the table's "
                             "end; the compare with the next node then moves the query into the right interval "
                             "(tests/test_torch_core.py compares the lookup with scipy's PCHIP).")
-NOTES[("_parallel", "L96 n <= 1")] = ("equivalent: with one thread, one_thread sets torch's thread count to 1 "
+NOTES[("_parallel", "L101 n <= 1")] = ("equivalent: with one thread, one_thread sets torch's thread count to 1 "
                                       "and restores it to 1 instead of returning at once; same results and settings.")
 NOTES[("expectation", "L269 A * sqrt_1mB2")] = (
     "accuracy only: it moves the sky disc's outer panel limits where the Gaussian window (7.5σ) ends "
