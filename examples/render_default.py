@@ -12,6 +12,9 @@ statistics). Writes to ``--out``:
 
 Usage:
     python examples/render_default.py [--out outputs/default] [--batch 8] [--height 512] [--width 640]
+
+(from the repository's root; the README's quick start runs it from ``examples/`` with
+``--out ../outputs/default``, the same place)
 """
 
 from __future__ import annotations

@@ -289,7 +289,7 @@ class TextureTable:
         self.time = per_batch("time_s", scene.time_s, B, dtype, device)
         self.quadrature = tuple(int(v) for v in table.texture_quadrature)
         self.min_band_share = float(table.texture_min_band_share)
-        self._warned = False
+        self.scaled = False  # whether some resolved slopes were scaled down (reconcile_scale)
 
     def field(self, sl: slice, p: dict) -> Any:
         """The wave field of images ``sl``."""
@@ -300,15 +300,8 @@ class TextureTable:
         cov = wf.resolved_covariance(L)
         ex = (slice(None),) + (None,) * (L.ndim - 1)
         lam = reconcile_scale(cov, *(p[k][sl][ex] for k in ("vx", "vy", "cxy", "wind_direction")))
-        if not self._warned and bool((lam < 1).any()):
-            import warnings
-
-            # one fixed text, so Python's default filter shows it once per session, not once a batch
-            warnings.warn("SeaScene(seed=...): where a pixel's footprint resolves more slope variance in the wave "
-                          "spectrum than the scene's slope law allows (ECKV against Cox-Munk: light winds, "
-                          "centimetre footprints), the resolved slopes are scaled down so that the two scales still "
-                          "add up to SlopeStatistics (roughsea_torch.clutter.reconcile_scale)", stacklevel=5)
-            self._warned = True
+        if not self.scaled and bool((lam < 1).any()):
+            self.scaled = True  # the renderer warns once the render is done, from the caller's thread
         return tuple(c * lam * lam for c in cov), lam
 
     def node_values(self, sl: slice, p: dict, wf: Any, ph_nodes: torch.Tensor, sky: Any, scene: Any, q: Any,

@@ -26,6 +26,7 @@ autograd graph when nothing requires grad; per-pixel temporaries for ``chunk`` i
 from __future__ import annotations
 
 import math
+import os
 import threading
 from dataclasses import dataclass
 from functools import lru_cache
@@ -1755,9 +1756,30 @@ def _render_table(
     chunks = [slice(i, min(i + chunk, B)) for i in range(0, B, chunk)]
     out = torch.empty(B, H, W, dtype=dtype, device=device) if len(chunks) > 1 else None
     parts = map_chunks(one, chunks, device)
+    if textured and tex.scaled:
+        _warn_scaled()
     if parts[0] is None:
         return out
     return parts[0] if len(parts) == 1 else torch.cat(parts)
+
+
+def _warn_scaled() -> None:
+    """The warning of :func:`~roughsea_torch.clutter.reconcile_scale`, from the calling thread (the
+    chunks run on workers) and pointing at the user's line: the first frame outside this package,
+    kornia and torch (an augmentation's own call chain runs through both)."""
+    import sys
+    import warnings
+
+    here = os.path.dirname(os.path.abspath(__file__))
+    others = tuple(os.path.dirname(os.path.abspath(m.__file__)) for m in (torch, sys.modules.get("kornia")) if m is not None)
+    frame, level = sys._getframe(1), 2  # stacklevel 2: the caller of this function
+    while frame is not None and frame.f_code.co_filename.startswith((here, *others)):
+        frame, level = frame.f_back, level + 1
+    # one fixed text, so Python's default filter shows it once per calling line, not once a batch
+    warnings.warn("SeaScene(seed=...): where a pixel's footprint resolves more slope variance in the wave spectrum than "
+                  "the scene's slope law allows (ECKV against Cox-Munk: light winds, centimetre footprints), the "
+                  "resolved slopes are scaled down so that the two scales still add up to SlopeStatistics "
+                  "(roughsea_torch.clutter.reconcile_scale)", stacklevel=level)
 
 
 def _kelvin(radiance: torch.Tensor, band: SpectralBand) -> torch.Tensor:

@@ -367,3 +367,18 @@ def test_resolved_quantile_is_the_normalized_slope_ratio(dtype):
                               torch.tensor(0.5, dtype=dtype))
         grads = torch.autograd.grad(x, (c, s_))
         assert float(x.detach()) == 0.0 and all(bool((gr == 0).all()) for gr in grads)
+
+
+def test_scaling_warning_points_at_the_callers_line():
+    """Where the spectrum resolves more slope variance than the slope law allows (2 m/s, a 3 m mast
+    looking 30° down through a 10° lens: centimetre footprints), render() warns once, from the
+    calling thread, at the caller's line (it pointed into concurrent.futures when a worker raised it)."""
+    cams = rs.make_camera(32, 40, altitude_m=3.0, pitch_deg=-30.0, hfov_deg=10.0, batch_size=2)
+    old = torch.get_num_threads()
+    try:
+        torch.set_num_threads(2)  # two chunks on the worker threads
+        with pytest.warns(UserWarning, match="resolved slopes are scaled down") as rec:
+            rs.render(cams, rs.SeaScene(wind_speed=2.0, sea_temperature=290.0, seed=[1, 2]))
+    finally:
+        torch.set_num_threads(old)
+    assert len(rec) == 1 and rec[0].filename == __file__
