@@ -17,6 +17,11 @@ training step; the dataset generator's scaling with DataLoader workers.
    size (128×160) and at 512×640.
 3. ``roughsea_torch.dataset.generate`` at 512×640 with 0 (in-process), 1 and 2 DataLoader workers:
    images/s and speed-up over 1 worker (each worker renders whole shards with one torch thread).
+4. glibc's allocator: the renderer, the sensor and ``RandomSeaBackground`` (replace) on 1 thread in
+   child processes started with and without ``MALLOC_MMAP_THRESHOLD_`` and
+   ``MALLOC_TRIM_THRESHOLD_`` raised to 4 GiB (freed memory is then kept and reused instead of
+   handed back to the system, so a fresh full-size temporary does not page-fault), with the minor
+   page faults of one call.
 
 Writes ``--out``/bench_augmentation.md and .png.
 
@@ -87,6 +92,41 @@ def cpu_name() -> str:
     return platform.processor() or "unknown CPU"
 
 
+MALLOC_ENV = {"MALLOC_MMAP_THRESHOLD_": "4294967296", "MALLOC_TRIM_THRESHOLD_": "4294967296"}
+
+
+def malloc_child(repeats: int, B: int, H: int, W: int) -> None:
+    """Section 4's child: median time [s] and minor page faults of one call of each stage, 1 thread."""
+    import json
+    import resource
+
+    torch.set_num_threads(1)
+    aug = RandomSeaBackground(sensor=SensorModel.typical_lwir(), texture=False)
+    params = aug.sampler.sample(B, torch.Generator().manual_seed(2))
+    L = render_parameters(params, H, W, aug.sampler.atmospheres)
+    sensor = SensorModel.typical_lwir()
+    x = torch.zeros(B, 1, H, W)
+    stages = {
+        "renderer": lambda: render_parameters(params, H, W, aug.sampler.atmospheres),
+        "sensor": lambda: sensor(L, generator=[torch.Generator().manual_seed(i) for i in range(B)]),
+        "RandomSeaBackground + sensor, replace": lambda: aug(x, params=aug._params),
+    }
+    aug(x, generator=torch.Generator().manual_seed(0))
+    out = {}
+    with torch.no_grad():
+        for name, fn in stages.items():
+            fn()
+            ts, faults = [], []
+            for _ in range(repeats):
+                f0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+                t0 = time.perf_counter()
+                fn()
+                ts.append(time.perf_counter() - t0)
+                faults.append(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0)
+            out[name] = (statistics.median(ts), statistics.median(faults))
+    print(json.dumps(out))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeats", type=int, default=5)
@@ -99,7 +139,11 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=ROOT / "docs")
     ap.add_argument("--texture", action=argparse.BooleanOptionalAction, default=True,
                     help="textured seas (RandomSeaBackground's default) or expectation images (--no-texture)")
+    ap.add_argument("--malloc-child", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args()
+    if a.malloc_child:
+        malloc_child(a.repeats, a.batch, a.height, a.width)
+        return
     dev = torch.device(a.device)
     sync = (lambda: torch.cuda.synchronize()) if dev.type == "cuda" else (lambda: None)
     B, H, W = a.batch, a.height, a.width
@@ -201,6 +245,25 @@ def main() -> None:
     for w_, ips in gen.items():
         label = f"0 (in-process, {torch.get_num_threads()} threads)" if w_ == 0 else f"{w_} (1 thread each)"
         lines.append(f"| {label} | {ips:.2f} | {ips / gen[1]:.2f} |")
+    # 4. glibc's allocator: freed memory kept for reuse, or handed back (and page-faulted in again)
+    import json
+
+    runs = {}
+    for label, extra in (("default", {}), ("thresholds raised", MALLOC_ENV)):
+        env = {k: v for k, v in os.environ.items() if k not in MALLOC_ENV}
+        child = subprocess.run([sys.executable, __file__, "--malloc-child", "--repeats", str(a.repeats), "--batch", str(B),
+                                "--height", str(H), "--width", str(W)], capture_output=True, text=True, check=True,
+                               env=dict(env, **extra))
+        runs[label] = json.loads(child.stdout.strip().splitlines()[-1])
+    lines += ["", f"## 4. glibc's allocator, {B}×{H}×{W}, 1 thread, expectation images", "",
+              "Child processes started with glibc's defaults and with `MALLOC_MMAP_THRESHOLD_=4294967296 "
+              "MALLOC_TRIM_THRESHOLD_=4294967296` (freed memory kept for reuse instead of handed back to the "
+              f"system); medians of {a.repeats}, minor page faults of one call.", "",
+              "| stage | default [ms] | page faults | thresholds raised [ms] | page faults | × faster |",
+              "|---|---:|---:|---:|---:|---:|"]
+    for name in runs["default"]:
+        (t0_, f0_), (t1_, f1_) = runs["default"][name], runs["thresholds raised"][name]
+        lines.append(f"| {name} | {1e3 * t0_:.0f} | {f0_:.0f} | {1e3 * t1_:.0f} | {f1_:.0f} | {t0_ / t1_:.2f} |")
     text = "\n".join(lines) + "\n"
     print(text)
     a.out.mkdir(parents=True, exist_ok=True)
