@@ -427,6 +427,8 @@ def _render_frames(
     thread); no gradient may flow then, and the images are the same either way (the workers take
     the caller's CPU autocast too)."""
     B, T = frames["time_s"].shape
+    # None: torch's default device, resolved here (it is per thread, and the renders may run on workers)
+    device = torch.get_default_device() if device is None else torch.device(device)
     out = torch.empty(B, T, 1, height, width, dtype=dtype, device=device)
     atm = params["atmosphere"].cpu()
     band = as_band(band)

@@ -250,3 +250,20 @@ def test_textured_render_of_two_images_uses_the_workers(two_threads, monkeypatch
     cams = rs.make_camera(16, 20, altitude_m=20.0, pitch_deg=-6.0, batch_size=2)
     rs.render(cams, rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, seed=[1, 2]))
     assert len(names) >= 2 and all(n.startswith("roughsea") for n in names)
+
+
+@pytest.mark.skipif(not torch.cuda.is_available(), reason="needs CUDA")
+def test_default_device_reaches_the_renders():
+    """render_parameters(device=None) under torch.set_default_device("cuda") renders on CUDA (the
+    default device is per thread: it is resolved before any render runs elsewhere)."""
+    s = rs.SceneSampler(atmospheres=["midlatitude_summer", "tropical"])
+    p = s.sample(4, torch.Generator().manual_seed(3))
+    p["atmosphere"] = torch.tensor([0, 1, 0, 1])
+    from roughsea_torch.augmentation import render_parameters
+
+    torch.set_default_device("cuda")
+    try:
+        img = render_parameters(p, 12, 16, s.atmospheres)
+    finally:
+        torch.set_default_device("cpu")
+    assert img.device.type == "cuda"
