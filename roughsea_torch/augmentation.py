@@ -50,7 +50,7 @@ from .expectation import Quadrature
 from .geometry import EARTH_RADIUS_M, make_camera
 from .motion import PlatformMotion
 from .radiometry import LWIR, as_band, band_radiance, brightness_temperature
-from .render import DEFAULT_CHUNK, SeaScene, TableSize, render
+from .render import SeaScene, TableSize, _chunk_images, render
 from .sensor import SensorModel
 
 __all__ = [
@@ -421,7 +421,7 @@ def _render_frames(
     """(B, T, 1, H, W): frame t of image b from the fields of ``params`` (B,), with pose and time
     from ``frames`` (B, T). Images are grouped by atmosphere and by textured or not; a group's
     scene is built once and its wave fields reused from frame to frame. Where every render is one
-    chunk of the renderer (expectation images, at most ``render.DEFAULT_CHUNK`` of them) and there
+    chunk of the renderer (expectation images, at most ``render.DEFAULT_CHUNK`` of them, 4) and there
     are several, the renders themselves are spread over the worker threads
     (:func:`~roughsea_torch._parallel.map_chunks`; without it each would run alone on the calling
     thread); no gradient may flow then, and the images are the same either way (the workers take
@@ -473,7 +473,7 @@ def _render_frames(
                 frame_scene.time_s = pose["time_s"][:, t]
             cam_t = dict(cam, altitude_m=pose["altitude_m"][:, t], pitch_deg=pose["pitch_deg"][:, t],
                          roll_deg=pose["roll_deg"][:, t])
-            jobs.append((idx, t, cam_t, frame_scene, not tex and idx.numel() <= DEFAULT_CHUNK))
+            jobs.append((idx, t, cam_t, frame_scene, not tex and idx.numel() <= _chunk_images(frame_scene)))
 
     def run(job: tuple) -> None:
         idx, t, cam_t, frame_scene, _ = job

@@ -51,6 +51,27 @@ from .slopes import SlopeStatistics
 __all__ = ["SeaScene", "render", "SeaRenderer", "TableSize"]
 
 DEFAULT_CHUNK = 4  # images per chunk of an expectation render (render's ``chunk``; textured scenes: 1)
+
+
+def _cached_one(cache: dict, key: Any, load: Any) -> Any:
+    """``cache[key]``, made by ``load()`` when missing and then the cache's only entry; under a lock,
+    since renders of one scene may run side by side (``augmentation._render_frames``) and the
+    value is returned as made, never read back after another thread's fill."""
+    with _CACHE_LOCK:
+        value = cache.get(key)
+        if value is None:
+            value = load()
+            cache.clear()
+            cache[key] = value
+    return value
+
+
+def _chunk_images(scene: Any, chunk: Any = None) -> Any:
+    """Images per chunk of pixels: ``chunk`` if given (render checks it), else 1 for a textured scene
+    (its per-pixel work holds a dozen more full-size temporaries) and ``DEFAULT_CHUNK`` otherwise."""
+    return chunk if chunk is not None else 1 if scene.seed is not None else DEFAULT_CHUNK
+
+
 _CACHE_LOCK = threading.RLock()  # SeaScene's caches (skies, wave fields), filled from worker threads
 
 
@@ -303,17 +324,10 @@ class SeaScene:
         through ``sun_zenith=`` with a named atmosphere and an ``aerosol``; else None."""
         if self.sun_zenith is None or self._sun is not None or self.atmosphere is None or self.aerosol is None:
             return None
-        key = (self.atmosphere, self.aerosol, self.band)
-        with _CACHE_LOCK:  # renders of one scene may run side by side (augmentation._render_frames)
-            sky = self._day_skies.get(key)
-            if sky is None:
-                from .daysky import load_scattered_sky
+        from .daysky import load_scattered_sky
 
-                sky = load_scattered_sky(self.atmosphere, (self.band.lo, self.band.hi), aerosol=self.aerosol,
-                                         response=self.band.response)
-                self._day_skies.clear()
-                self._day_skies[key] = sky
-        return sky
+        return _cached_one(self._day_skies, (self.atmosphere, self.aerosol, self.band), lambda: load_scattered_sky(
+            self.atmosphere, (self.band.lo, self.band.hi), aerosol=self.aerosol, response=self.band.response))
 
     @property
     def observer_sky(self) -> Any:
@@ -323,16 +337,10 @@ class SeaScene:
         air); else None (the sky seen from sea level). Follows the scene's current fields."""
         if self.atmosphere is None or self.path is None or getattr(self.path, "name", None) != self.atmosphere:
             return None
-        key = (self.atmosphere, self.band)
-        with _CACHE_LOCK:
-            sky = self._observer_skies.get(key)
-            if sky is None:
-                from .atmosphere import load_observer_sky
+        from .atmosphere import load_observer_sky
 
-                sky = load_observer_sky(self.atmosphere, self.band, dtype=torch.float64)
-                self._observer_skies.clear()
-                self._observer_skies[key] = sky
-        return sky
+        return _cached_one(self._observer_skies, (self.atmosphere, self.band),
+                           lambda: load_observer_sky(self.atmosphere, self.band, dtype=torch.float64))
 
     @property
     def batch_size(self) -> int:
@@ -908,9 +916,9 @@ def render(
                        quadrature=quadrature, geometry=geometry, chunk=chunk)
 
     ref = geometry.cos_view_zenith if geometry is not None else getattr(cameras, "intrinsics", None)
-    per_chunk = (chunk if isinstance(chunk, int) and chunk > 0 else 1 if getattr(scene, "seed", None) is not None
-                 else DEFAULT_CHUNK)
-    if method == "table" and isinstance(ref, torch.Tensor) and ref.ndim > 0 and ref.shape[0] <= per_chunk:
+    per_chunk = _chunk_images(scene, chunk)
+    if (method == "table" and isinstance(ref, torch.Tensor) and ref.ndim > 0 and isinstance(per_chunk, int)
+            and ref.shape[0] <= per_chunk):
         return one_thread(call, ref.device)
     return call()
 
@@ -930,8 +938,7 @@ def _render(
     """:func:`render`'s body."""
     if method not in ("table", "direct"):
         raise ValueError(f"method must be 'table' or 'direct'; got {method!r}")
-    if chunk is None:
-        chunk = 1 if scene.seed is not None else DEFAULT_CHUNK
+    chunk = _chunk_images(scene, chunk)
     if output not in ("radiance", "brightness_temperature"):
         raise ValueError(f"output must be 'radiance' or 'brightness_temperature'; got {output!r}")
     if geometry is not None:

@@ -346,11 +346,16 @@ _CHUNK_ELEMENTS = 2**18  # point-evaluations per chunk in WaveField.sample
 _BLOCK = 512  # points per block of the footprint's range (WaveField._sample_points)
 
 
-def _window(footprint: torch.Tensor, k_centre: float) -> torch.Tensor:
-    """w = 1 − smoothstep(t), t = clamp((u − u₀)/(u₁ − u₀), 0, 1), u = k_o f / π (see band_weights)."""
-    scale = k_centre / math.pi / (_WIN_HI - _WIN_LO)
-    shift = _WIN_LO / (_WIN_HI - _WIN_LO)
-    t = torch.clamp(footprint * scale - shift, 0.0, 1.0)
+def _window(footprint: torch.Tensor, k_centre: float | Sequence[float]) -> torch.Tensor:
+    """w = 1 − smoothstep(t), t = clamp((u − u₀)/(u₁ − u₀), 0, 1), u = k_o f / π (see band_weights),
+    for one band's centre k_o, or for a sequence of them (one more trailing axis, a band each)."""
+    if isinstance(k_centre, (list, tuple)):
+        scale = torch.tensor([k / math.pi / (_WIN_HI - _WIN_LO) for k in k_centre], dtype=footprint.dtype,
+                             device=footprint.device)
+        footprint = footprint[..., None]
+    else:
+        scale = k_centre / math.pi / (_WIN_HI - _WIN_LO)
+    t = torch.clamp(footprint * scale - _WIN_LO / (_WIN_HI - _WIN_LO), 0.0, 1.0)
     return 1.0 - t * t * (3.0 - 2.0 * t)
 
 
@@ -678,12 +683,7 @@ class WaveField:
             footprint: f ≥ 0 [m], tensor of any shape (float accepted); 0 gives all 1, +inf all 0.
                 Differentiable (the gradient is 0 where w is 0 or 1).
         """
-        f = self._footprint_tensor(footprint)
-        # every band at once (one op each over (..., n_bands)), the arithmetic of _window
-        scale = torch.tensor([k / math.pi / (_WIN_HI - _WIN_LO) for k in self.bands.band_wavenumber], dtype=f.dtype,
-                             device=f.device)
-        t = torch.clamp(f[..., None] * scale - _WIN_LO / (_WIN_HI - _WIN_LO), 0.0, 1.0)
-        return 1.0 - t * t * (3.0 - 2.0 * t)
+        return _window(self._footprint_tensor(footprint), tuple(self.bands.band_wavenumber))  # every band at once
 
     def band_covariance(self) -> torch.Tensor:
         """Expected world-frame slope covariance of each band, (B, n_bands, 3) = (var_x, var_y, cov_xy).
