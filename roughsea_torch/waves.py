@@ -344,6 +344,7 @@ _WIN_LO = 1.0 / math.sqrt(2.0)  # u = k_o f / π below which a band is fully res
 _WIN_HI = math.sqrt(2.0)  # u above which it is fully unresolved (w = 0)
 _CHUNK_ELEMENTS = 2**18  # point-evaluations per chunk in WaveField.sample
 _BLOCK = 512  # points per block of the footprint's range (WaveField._sample_points)
+_DOUBLED_ELEMENTS = 2**21  # elements of the doubled band tiles made in one copy (WaveField._sample_points)
 
 
 def _window(footprint: torch.Tensor, k_centre: float | Sequence[float]) -> torch.Tensor:
@@ -868,9 +869,9 @@ class WaveField:
         """Σ_o w_o · bilinear(tile_o) at points xy (B, P, 2) → (B, C, P).
 
         Band by band, then chunk by chunk of about 2**18 point-evaluations (the temporaries stay in
-        cache). Each band's tile is doubled to 2N + 1 texels per side (the period twice, circularly)
-        so that its grid is ``frac(x / L_o)`` ∈ (−1, 1) straight away: ``frac`` costs a quarter of
-        the floor-division ``remainder``. Points beyond a band's window (w = 0) are not evaluated,
+        cache). Each band's tile is doubled to 2N + 1 texels per side (the period twice, circularly;
+        several bands per copy, up to ``_DOUBLED_ELEMENTS``) so that its grid is ``frac(x / L_o)``
+        ∈ (−1, 1) straight away: ``frac`` costs a quarter of the floor-division ``remainder``. Points beyond a band's window (w = 0) are not evaluated,
         and the window multiplies only the points where it is below 1: both found from the
         footprint's minimum and maximum over blocks of points, so the skipped work would have
         added exactly 0 or multiplied by exactly 1 (results do not depend on chunks or blocks). A
@@ -886,19 +887,36 @@ class WaveField:
             fb = f_all if pad == 0 else torch.cat([f_all, f_all[:, -1:].expand(batch, pad)], 1)
             fb = fb.reshape(batch, nblk, _BLOCK)
             f_min, f_max = fb.amin(dim=(0, 2)), fb.amax(dim=(0, 2))
+            f_min, f_max = f_min.cpu().numpy(), f_max.cpu().numpy()
         margin = 1e-3  # the tensor window is exactly 0 (or 1) well inside these bounds
         n = tiles.shape[-1] - 1
-        for o, (k_o, length) in enumerate(zip(self.bands.band_wavenumber, self.bands.tile_length)):
+        work = []  # (band, point runs, blocks where the window may be < 1) of the bands that add something
+        for o, k_o in enumerate(self.bands.band_wavenumber):
             if not self._band_on[:, o].any():
                 continue
             runs, part = [(0, npts)], None
             if f_all is not None:
-                runs = _runs((f_min < _WIN_HI * (1.0 + margin) * math.pi / k_o).cpu().numpy(), npts)
+                runs = _runs(f_min < _WIN_HI * (1.0 + margin) * math.pi / k_o, npts)
                 if not runs:
                     continue
-                part = (f_max > _WIN_LO * (1.0 - margin) * math.pi / k_o).cpu().numpy()  # blocks where w may be < 1
-            # the tile doubled: the period twice, plus texel 2N = texel 0 (circular pad)
-            tile = F_nn.pad(tiles[o][..., :n, :n].repeat(1, 1, 2, 2), (0, 1, 0, 1), mode="circular")
+                part = f_max > _WIN_LO * (1.0 - margin) * math.pi / k_o
+            work.append((o, runs, part))
+        # the tiles doubled: the period twice, plus texel 2N = texel 0 (circular), a few bands per copy
+        per_copy = max(1, _DOUBLED_ELEMENTS // (tiles[0].numel() // (n + 1) ** 2 * (2 * n + 1) ** 2))
+        doubled: dict[int, torch.Tensor] = {}
+        for i, (o, runs, part) in enumerate(work):
+            if o not in doubled:
+                group = [w[0] for w in work[i:i + per_copy]]
+                core = tiles.index_select(0, torch.tensor(group, device=tiles.device))[..., :n, :n]
+                copy = core.new_empty(core.shape[:-2] + (2 * n + 1, 2 * n + 1))
+                for rows in (slice(0, n), slice(n, 2 * n)):
+                    for cols in (slice(0, n), slice(n, 2 * n)):
+                        copy[..., rows, cols] = core
+                copy[..., 2 * n, :] = copy[..., 0, :]
+                copy[..., :, 2 * n] = copy[..., :, 0]
+                doubled = {g: copy[j] for j, g in enumerate(group)}
+            tile = doubled[o]
+            k_o, length = self.bands.band_wavenumber[o], self.bands.tile_length[o]
             for lo, hi in runs:
                 for a in range(lo, hi, chunk):
                     e = min(hi, a + chunk)
