@@ -288,6 +288,9 @@ class TextureTable:
         self.centres = cg.centres.to(dtype)
         self.time = per_batch("time_s", scene.time_s, B, dtype, device)
         self.quadrature = tuple(int(v) for v in table.texture_quadrature)
+        self.quadrature_steep = tuple(int(v) for v in table.texture_quadrature_steep)
+        self.steep_cos = math.cos(math.radians(float(table.texture_steep_zenith_deg)))
+        self.window = float(table.texture_quadrature_width)
         self.min_band_share = float(table.texture_min_band_share)
         self.scaled = False  # whether some resolved slopes were scaled down (reconcile_scale)
 
@@ -351,22 +354,42 @@ class TextureTable:
         # the difference of two evaluations whose quadrature errors nearly cancel, so the texture
         # nodes can take a coarser rule than the mean table (TableSize.texture_quadrature)
         cols = shifted.mean_upwind.shape
-        stats = SlopeStatistics.from_variances(
-            *(torch.cat([a.expand(cols), b[:, None]], 1) for a, b in ((shifted.var_upwind, vx[img, 0, 0]),
-                                                                    (shifted.var_crosswind, vy[img, 0, 0]),
-                                                                    (shifted.cov, cxy[img, 0, 0])))
-        ).shifted(*(torch.cat([m, torch.zeros_like(m[:, :1])], 1) for m in (shifted.mean_upwind, shifted.mean_crosswind)))
-        if isinstance(sky, TabulatedSky) and sky.radiance.ndim == 4 and sky.radiance.shape[2] > 1:
-            # a sky per azimuth node (by day: the scattered sky along each node's mirror azimuth)
-            sky_m = sky.with_radiance(sky.radiance[:, 0].to(dtype=dtype, device=device)[img, idx[2]][:, None, :])
+        moments = [torch.cat([a.expand(cols), b[:, None]], 1) for a, b in ((shifted.var_upwind, vx[img, 0, 0]),
+                                                                          (shifted.var_crosswind, vy[img, 0, 0]),
+                                                                          (shifted.cov, cxy[img, 0, 0]))]
+        moments += [torch.cat([m, torch.zeros_like(m[:, :1])], 1) for m in (shifted.mean_upwind, shifted.mean_crosswind)]
+        day_sky = isinstance(sky, TabulatedSky) and sky.radiance.ndim == 4 and sky.radiance.shape[2] > 1
+
+        def terms(sel: torch.Tensor | slice, outer: int, inner: int) -> tuple[torch.Tensor, torch.Tensor]:
+            """(T_s, T_ρ) of the active nodes ``sel`` on an (outer, inner) rule whose Gaussian window
+            is cut at ±texture_quadrature_width standard deviations."""
+            im = img[sel]
+            stats = SlopeStatistics.from_variances(*(m[sel] for m in moments[:3])).shifted(*(m[sel] for m in moments[3:]))
+            if day_sky:  # a sky per azimuth node (by day: the scattered sky along each node's mirror azimuth)
+                sky_m = sky.with_radiance(sky.radiance[:, 0].to(dtype=dtype, device=device)[im, idx[2][sel]][:, None, :])
+            else:
+                sky_m = _sky_per_image(select_sky(sky_of_chunk(sky, b_), im.cpu()), im.numel(), dtype, device, 1)
+            t_s, t_rho, _ = _reflection_terms(torch.acos(ct[sel].clamp(-1.0, 1.0))[:, None], ph[sel][:, None], stats,
+                                              (p["n"][sl][im, None], p["k"][sl][im, None]), sky_m, scene.shadowing,
+                                              q.with_(outer=outer, inner=inner, width=min(float(q.width), self.window)),
+                                              None, scene.sky_masking)
+            if p["air_scale"] is not None:
+                t_s = t_s * p["air_scale"][sl][im, None].to(t_s.dtype)
+            return t_s, t_rho
+
+        # steep views (θ̂ < texture_steep_zenith_deg) take a finer rule: there the texture is a few mK
+        # and the shifted Gaussian, narrow and near the edge of the sky-reflecting disc, needs it
+        steep = ct > self.steep_cos
+        if not bool(steep.any()):
+            t_s, t_rho = terms(slice(None), *self.quadrature)
+        elif bool(steep.all()):
+            t_s, t_rho = terms(slice(None), *self.quadrature_steep)
         else:
-            sky_m = _sky_per_image(select_sky(sky_of_chunk(sky, b_), img.cpu()), img.numel(), dtype, device, 1)
-        outer, inner = self.quadrature
-        t_s, t_rho, _ = _reflection_terms(torch.acos(ct.clamp(-1.0, 1.0))[:, None], ph[:, None], stats,
-                                          (p["n"][sl][img, None], p["k"][sl][img, None]), sky_m, scene.shadowing,
-                                          q.with_(outer=outer, inner=inner), None, scene.sky_masking)
-        if p["air_scale"] is not None:
-            t_s = t_s * p["air_scale"][sl][img, None].to(t_s.dtype)
+            parts = [(m.nonzero().flatten(), terms(m.nonzero().flatten(), *rule))
+                     for m, rule in ((~steep, self.quadrature), (steep, self.quadrature_steep))]
+            t_s, t_rho = (torch.zeros(ct.shape[0], cols[1] + 1, dtype=parts[0][1][0].dtype, device=device)
+                          .index_put((parts[0][0],), parts[0][1][i]).index_put((parts[1][0],), parts[1][1][i])
+                          for i in (0, 1))
         rb = p["rb"][sl][img, None].to(t_s.dtype)
         v = rb - rb * t_rho + t_s
         delta = torch.zeros(b_, nz, nphi, self.xnodes.numel(), dtype=dtype, device=device)

@@ -533,6 +533,18 @@ class TableSize:
             sunny), as a share of the texture's amplitude: (12, 16) 2e-4 to 1.8e-2, as (20, 16)
             (2e-4 to 2.8e-2); (10, 16) up to 5.3e-2, (16, 12) up to 2.8e-2 and 9e-3 where (12, 16)
             has 1.7e-3. The x nodes (``texture``) set the worst case: 11 bring 2.8e-2 to 1.1e-2.
+        texture_quadrature_steep, texture_steep_zenith_deg: the rule of the texture nodes whose view
+            zenith θ̂ is below ``texture_steep_zenith_deg`` [deg]. Looking steeply down, the texture is
+            a few mK while the shifted Gaussians are narrow and reach the edge of the
+            sky-reflecting disc: (12, 16) left up to 3.4e-3 K against per-pixel evaluation at 15–20 m/s
+            (θ̂ < 35°, LWIR), (16, 16) 4e-4 K; from θ̂ ≈ 40° the two agree (``tests/test_clutter.py``).
+        texture_quadrature_width: half-width [standard deviations] of the Gaussian window of the
+            texture nodes' rule (the render's quadrature's, if narrower). The default model's 7.5
+            (float64) is too wide for a 12-node rule: Gauss–Legendre on ±7.5σ misses 1 % of a
+            Gaussian's mass, on ±4.5σ 1e-5 (the window drops 7e-6); looking straight down at 8 m/s
+            the texture was then 0.11 K off per-pixel evaluation (float64; 0.015 K in float32, whose
+            window is 6σ) against 1e-4 K now. Grazing views, where the texture is tens of mK, move
+            by less than 1e-4 K.
             Under a LOWTRAN day sky (``sun_zenith=``), glint pixels reflect the aureole about the
             sun and the departure is sharp in slope and azimuth: an MWIR sea then sits 1.1e-3 of
             the radiance from a converged per-pixel render; ``texture_quadrature=(20, 16)``,
@@ -571,6 +583,9 @@ class TableSize:
     fine_texture_zenith: int = 512
     fine_texture_azimuth: int = 16
     texture_quadrature: tuple = (12, 16)
+    texture_quadrature_steep: tuple = (16, 16)
+    texture_steep_zenith_deg: float = 40.0
+    texture_quadrature_width: float = 4.5
     texture_min_band_share: float = 1e-8
     texture_azimuth_sun: int = 9
     zenith_narrow: int = 21
@@ -589,6 +604,15 @@ class TableSize:
                      "fine_texture_zenith", "fine_texture_azimuth"):
             if int(getattr(self, name)) < 4 * _EXT + 2:
                 raise ValueError(f"TableSize.{name} must be >= {4 * _EXT + 2}")
+        for name in ("texture_quadrature", "texture_quadrature_steep"):
+            rule = getattr(self, name)
+            if (not isinstance(rule, (tuple, list)) or len(rule) != 2
+                    or not all(isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= 512 for v in rule)):
+                raise ValueError(f"TableSize.{name} must be (outer, inner), two ints in [1, 512]; got {rule!r}")
+        for name, lo, hi in (("texture_steep_zenith_deg", 0.0, 90.0), ("texture_quadrature_width", 1.0, 40.0)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo <= float(v) <= hi:
+                raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")
         share = self.texture_min_band_share
         if isinstance(share, bool) or not isinstance(share, (int, float)) or not 0.0 <= float(share) < 1.0:
             raise ValueError(f"TableSize.texture_min_band_share must be a number in [0, 1); got {share!r}")

@@ -145,6 +145,29 @@ def test_texture_table_matches_per_pixel_evaluation():
     assert float(err.max() / direct.max()) < 3e-4
 
 
+@pytest.mark.parametrize("dtype", [torch.float64, torch.float32])
+@pytest.mark.parametrize("wind,pitch", [(8.0, -90.0), (15.0, -90.0), (15.0, -50.0)])
+def test_texture_table_matches_per_pixel_evaluation_looking_steeply_down(wind, pitch, dtype):
+    """Looking steeply down (20 m up, pitch −90°, 30° field of view: θ̂ < 20°) the texture is a few
+    mK; the table render matches per-pixel evaluation to 0.2 of the texture's standard deviation
+    (0.025–0.066 measured, 6e-5 to 2e-4 K). At pitch −50° (θ̂ 25–55°) the nodes take both rules. Both parts of the texture nodes' rule are needed
+    (TableSize.texture_quadrature_width, texture_quadrature_steep): planted, the model's own
+    7.5σ window (float64; float32's is 6σ) with the (12, 16) rule left 0.036–0.082 K (13–29 std),
+    the 4.5σ window with (12, 16) left 1.7e-3 K at 15 m/s (0.6 std)."""
+    cams = rs.make_camera(24, 32, hfov_deg=30.0, altitude_m=20.0, pitch_deg=pitch, dtype=dtype)
+
+    def scene(seed):
+        return rs.SeaScene(wind_speed=torch.tensor(wind, dtype=dtype), sea_temperature=290.0, wind_direction=0.3,
+                           seed=seed, time_s=1.5, foam=0.0)
+
+    table, direct = (rs.render(cams, scene(12), method=m, output="brightness_temperature").double()
+                     for m in ("table", "direct"))
+    mean = rs.render(cams, scene(None), output="brightness_temperature").double()
+    std = float((direct - mean).std())
+    assert std > 1e-3  # there is a texture to get right
+    assert float((table - direct).abs().max()) < 0.2 * std
+
+
 def test_realization_depends_on_seed_and_time_only():
     """Image i of a batch equals the same seed rendered alone (any batch split); other seeds or times
     give other images."""
