@@ -533,6 +533,12 @@ class TableSize:
             sunny), as a share of the texture's amplitude: (12, 16) 2e-4 to 1.8e-2, as (20, 16)
             (2e-4 to 2.8e-2); (10, 16) up to 5.3e-2, (16, 12) up to 2.8e-2 and 9e-3 where (12, 16)
             has 1.7e-3. The x nodes (``texture``) set the worst case: 11 bring 2.8e-2 to 1.1e-2.
+            Under a LOWTRAN day sky (``sun_zenith=``), glint pixels reflect the aureole about the
+            sun and the departure is sharp in slope and azimuth: an MWIR sea then sits 7e-4 of
+            the radiance from a converged per-pixel render; ``texture_quadrature=(20, 16)``,
+            ``texture_azimuth_sun=17`` and ``fine_texture_azimuth=64`` together bring it to
+            2.4e-4 (the first alone 4.5e-4, the other two 6.9e-4) at 1.75× the time of a textured
+            day render (``tests/test_sun.py``).
         texture_quadrature_steep, texture_steep_zenith_deg: the rule of the texture nodes whose view
             zenith θ̂ is below ``texture_steep_zenith_deg`` [deg]. Looking steeply down, the texture is
             a few mK while the shifted Gaussians are narrow and reach the edge of the
@@ -543,14 +549,8 @@ class TableSize:
             (float64) is too wide for a 12-node rule: Gauss–Legendre on ±7.5σ misses 1 % of a
             Gaussian's mass, on ±4.5σ 1e-5 (the window drops 7e-6); looking straight down at 8 m/s
             the texture was then 0.11 K off per-pixel evaluation (float64; 0.015 K in float32, whose
-            window is 6σ) against 1e-4 K now. Grazing views, where the texture is tens of mK, move
-            by less than 1e-4 K.
-            Under a LOWTRAN day sky (``sun_zenith=``), glint pixels reflect the aureole about the
-            sun and the departure is sharp in slope and azimuth: an MWIR sea then sits 1.1e-3 of
-            the radiance from a converged per-pixel render; ``texture_quadrature=(20, 16)``,
-            ``texture_azimuth_sun=17`` and ``fine_texture_azimuth=64`` together bring it to
-            2.4e-4 (either alone leaves ~1e-3) at 1.75× the time of a textured day render
-            (``tests/test_sun.py``).
+            window is 6σ) against 2e-4 K now. Grazing views, where the texture is tens of mK, move
+            by 2e-4 K at most (``pipelines/texture_accuracy.py``).
         texture_min_band_share: per image, the octaves of the wave field that carry less than this
             share of its slope variance (and of its crest variable's) are left out of the
             realization, their variance left to the unresolved statistics (``WaveField(...,
