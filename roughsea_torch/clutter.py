@@ -286,7 +286,8 @@ class TextureTable:
         self.La = torch.as_tensor(La, dtype=dtype, device=device)
         self.ifov = 1.0 / cg.cameras.fx.to(dtype)  # δ [rad per pixel] at the image centre
         self.centres = cg.centres.to(dtype)
-        self.time = per_batch("time_s", scene.time_s, B, dtype, device)
+        # the wave phases ω t in float64 whatever the dtype: a float32 time rounds to 1/16 s at 1e6 s
+        self.time = per_batch("time_s", scene.time_s, B, torch.float64, device)
         self.quadrature = tuple(int(v) for v in table.texture_quadrature)
         self.quadrature_steep = tuple(int(v) for v in table.texture_quadrature_steep)
         self.steep_cos = math.cos(math.radians(float(table.texture_steep_zenith_deg)))
@@ -451,7 +452,7 @@ class TextureTable:
         X = cen[:, 0, None, None] + R * dx
         Y = cen[:, 1, None, None] + R * dy
         # (the field's own entry without the input checks: X, Y, L come from the finite geometry)
-        smp = wf._sample(X, Y, self.time[sl].to(torch.float64), L, elevation=False, crest=crest)
+        smp = wf._sample(X, Y, self.time[sl], L, elevation=False, crest=crest)
         gy = (2.0 * (zeta - lo.to(dtype)[:, None, None]) / span_z.to(dtype)[:, None, None] - 1.0) / (1.0 + self.ez)
         # σ_a of each pixel from the resolved covariance of its row: for one camera the footprint is a
         # function of θ̂ alone, so the covariance is tabulated on the texture's rows and read

@@ -1383,7 +1383,7 @@ def _sea_direct_textured(geom: ViewGeometry, cameras: PinholeCamera, p: dict[str
     R = torch.where(sea, geom.range_m, torch.ones_like(cos_t))
     L = footprint(R, cos_t, (1.0 / cameras.fx.to(dtype))[:, None, None])
     dx, dy = geom._dx, geom._dy
-    time = per_batch("time_s", scene.time_s, B, dtype, device)
+    time = per_batch("time_s", scene.time_s, B, torch.float64, device)  # wave phases in float64 (TextureTable)
     smp = wf.sample(centres[:, 0, None, None] + R * dx, centres[:, 1, None, None] + R * dy, time, footprint=L,
                     elevation=False, crest=p["foam"] is not None)
     cov = wf.resolved_covariance(L)
