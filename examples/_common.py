@@ -13,8 +13,9 @@ import torch  # noqa: E402
 
 
 def save_grid(images: torch.Tensor, titles: list[str], path: Path, *, label: str, cmap: str = "inferno",
-              ncols: int = 4, shared_scale: bool = False) -> None:
-    """Write a (B, 1, H, W) batch as a labelled image grid with colour bars."""
+              ncols: int = 4, shared_scale: bool = False, ranges: list[tuple[float, float]] | None = None) -> None:
+    """Write a (B, 1, H, W) batch as a labelled image grid with colour bars; ``ranges``: one (vmin,
+    vmax) per image (values beyond are clipped to the ends of the colour bar)."""
     imgs = images.detach().float().cpu().numpy()[:, 0]
     n = imgs.shape[0]
     ncols = min(ncols, n)
@@ -22,8 +23,9 @@ def save_grid(images: torch.Tensor, titles: list[str], path: Path, *, label: str
     h, w = imgs.shape[1:]
     fig, axes = plt.subplots(nrows, ncols, figsize=(3.6 * ncols, 3.6 * nrows * h / w + 0.6), squeeze=False)
     vmin, vmax = (np.nanmin(imgs), np.nanmax(imgs)) if shared_scale else (None, None)
-    for ax, img, title in zip(axes.flat, imgs, titles):
-        im = ax.imshow(img, cmap=cmap, vmin=vmin, vmax=vmax)
+    for i, (ax, img, title) in enumerate(zip(axes.flat, imgs, titles)):
+        lo, hi = ranges[i] if ranges is not None else (vmin, vmax)
+        im = ax.imshow(img, cmap=cmap, vmin=lo, vmax=hi)
         ax.set_title(title, fontsize=8)
         ax.set_xticks([])
         ax.set_yticks([])

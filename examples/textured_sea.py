@@ -4,7 +4,9 @@ Writes to ``--out``:
 
 - ``textured_winds.png``: for winds of 2, 5, 10 and 15 m/s, the expectation image (top row) and one
   realization of the same scene (``SeaScene(seed=...)``, bottom row): LWIR, midlatitude-summer
-  LOWTRAN7 sky and path, a camera 15 m above the sea looking 8° down (ranges 60 m to the horizon);
+  LOWTRAN7 sky and path, a camera 15 m above the sea looking 8° down (ranges 60 m to the horizon),
+  whitecaps on the crests (the default); one colour scale per wind, the 0.5–99.5 % range of the sea
+  pixels of both images;
 - ``textured_clip.gif``: a 4 s clip at 10 frames/s of one realization seen from a mast that
   pitches ±1° (6 s period), rolls ±2° (9 s) and heaves ±0.5 m (``rs.PlatformMotion``), grey scale
   fixed over the clip;
@@ -45,7 +47,15 @@ def main() -> None:
                     output="brightness_temperature")
     print(f"4 textured {args.height}x{args.width} images in {time.perf_counter() - t0:.2f} s")
     titles = [f"expectation, W = {w:g} m/s" for w in winds.tolist()] + [f"realization, W = {w:g} m/s" for w in winds.tolist()]
-    save_grid(torch.cat([mean, tex]), titles, args.out / "textured_winds.png", label="brightness temperature [K]")
+    # one colour scale per wind, shared by the expectation and the realization: the 0.5–99.5 % range of
+    # the sea pixels of both (the horizon's bright rows and the darkest whitecaps clip to its ends)
+    sea = rs.view_geometry(cams).is_sea  # (B, H, W)
+    ranges = []
+    for i in range(len(winds)):
+        v = torch.cat([mean[i, 0][sea[i]], tex[i, 0][sea[i]]])
+        ranges.append((float(v.quantile(0.005)), float(v.quantile(0.995))))
+    save_grid(torch.cat([mean, tex]), titles, args.out / "textured_winds.png", label="brightness temperature [K]",
+              ranges=ranges + ranges)
 
     motion = rs.PlatformMotion(height=args.height // 2, width=args.width // 2, hfov_deg=20.0, altitude_m=15.0,
                                pitch_deg=-5.0, pitch_amplitude_deg=1.0, roll_amplitude_deg=2.0, heave_amplitude_m=0.5)
