@@ -105,6 +105,8 @@ def per_batch(name: str, x: Any, n: int, dtype: torch.dtype, device: torch.devic
 def _values(x: Any) -> torch.Tensor:
     if isinstance(x, torch.Tensor):
         return x.detach()
+    if isinstance(x, np.ndarray) and np.iscomplexobj(x):  # keep the imaginary part for the check below
+        return torch.as_tensor(x)
     return torch.as_tensor(x, dtype=torch.float64)
 
 
@@ -121,10 +123,13 @@ def check_finite_range(
     """Raise ``ValueError`` naming ``name`` unless every value is a number in the given range."""
     if x is None:
         raise ValueError(f"{name} is required")
-    if isinstance(x, Number) and not isinstance(x, bool):
+    if isinstance(x, Number) and not isinstance(x, (bool, complex)):
         vals = torch.tensor([float(x)], dtype=torch.float64)
     else:
-        vals = _values(x)
+        try:
+            vals = _values(x)
+        except (TypeError, ValueError, RuntimeError):  # a string, a ragged list, a complex number ...
+            raise ValueError(f"{name} must be a real number or a tensor of real numbers; got {repr(x)[:80]}") from None
     if vals.is_complex():
         raise ValueError(f"{name} must be real, got a complex value")
     if vals.numel() == 0:

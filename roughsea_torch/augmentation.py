@@ -52,6 +52,7 @@ from .motion import PlatformMotion
 from .radiometry import LWIR, as_band, band_radiance, brightness_temperature
 from .render import SeaScene, TableSize, _chunk_images, render
 from .sensor import SensorModel
+from .waves import check_time
 
 __all__ = [
     "SceneSampler",
@@ -583,6 +584,52 @@ def _check_input(input: Any, mode: str) -> None:
                              f"[{lo:g}, {hi:g}]")
 
 
+# the per-image fields a draw may hold, each a tensor (B,); the first ones are always there
+_REQUIRED_PARAMS = (*_FIELD_NAMES, "atmosphere", "noise_seed")
+_PER_IMAGE_PARAMS = (*_REQUIRED_PARAMS, "wave_seed", "time_s", *_MOTION_NAMES, "phase_rad", "is_day",
+                     "sun_elevation_deg", "sun_azimuth_deg")
+
+
+def _check_params(params: Any, B: int, atmospheres: Sequence[str], gate_sizes: tuple[int, ...]) -> None:
+    """``ValueError`` naming the field of a draw (``params``, e.g. one replayed from ``_params``) that
+    does not fit an input of B images (clips): every per-image field a tensor of shape (B,), the gate
+    ``"batch_prob"`` of a size in ``gate_sizes``, ``atmosphere`` an integer index into
+    ``atmospheres``, ``noise_seed`` and ``wave_seed`` integers (wave seeds in [0, 2**63)), ``time_s``
+    finite times in [−1e9, 1e9] s (``SeaScene``'s)."""
+    if not isinstance(params, dict):
+        raise ValueError(f"params must be a dict of tensors (a draw, e.g. aug._params); got {type(params).__name__}")
+    missing = [k for k in _REQUIRED_PARAMS if k not in params]
+    if missing:
+        raise ValueError(f"params: missing {missing}; replay a draw of this augmentation (its _params)")
+    for k in _PER_IMAGE_PARAMS:
+        v = params.get(k)
+        if v is None:
+            continue
+        if not isinstance(v, torch.Tensor) or v.ndim != 1:
+            shape = tuple(v.shape) if isinstance(v, torch.Tensor) else type(v).__name__
+            raise ValueError(f"params[{k!r}]: must be a tensor of shape (B,) = ({B},), one value per image; got {shape}")
+        if v.shape[0] != B:
+            raise ValueError(f"params[{k!r}]: has {v.shape[0]} values but the input has B = {B} images; replay a "
+                             f"draw on an input of the batch size it was drawn for")
+    gate = params.get("batch_prob")
+    if gate is not None and (not isinstance(gate, torch.Tensor) or gate.numel() not in gate_sizes):
+        size = gate.numel() if isinstance(gate, torch.Tensor) else type(gate).__name__
+        raise ValueError(f"params['batch_prob']: must hold {' or '.join(map(str, sorted(set(gate_sizes))))} values "
+                         f"for an input of B = {B} images; got {size}")
+    for k in ("atmosphere", "noise_seed", "wave_seed"):
+        v = params.get(k)
+        if v is not None and (v.dtype.is_floating_point or v.dtype.is_complex or v.dtype == torch.bool):
+            raise ValueError(f"params[{k!r}]: must have an integer dtype (int64, as drawn); got {v.dtype}")
+    atm = params["atmosphere"]
+    if atm.numel() and not bool(((atm >= 0) & (atm < len(atmospheres))).all()):
+        raise ValueError(f"params['atmosphere']: indices must lie in [0, {len(atmospheres) - 1}] (into atmospheres="
+                         f"{list(atmospheres)}); got {atm.tolist()}")
+    if "wave_seed" in params and bool((params["wave_seed"] < 0).any()):
+        raise ValueError(f"params['wave_seed']: seeds must lie in [0, 2**63); got {params['wave_seed'].tolist()}")
+    if "time_s" in params:
+        check_time("params['time_s']", params["time_s"])
+
+
 def _check_output_settings(mode: str, target_unit: str, sensor: Any, output: str | None,
                            generator: torch.Generator | None) -> str:
     """The output kind of these settings, or ``ValueError`` naming the bad one."""
@@ -805,6 +852,7 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
         B, C, H, W = input.shape
         if self.mode == "composite" and C != 2:
             raise ValueError(f"input: mode='composite' needs 2 channels (target value, alpha); got {C}")
+        _check_params(params, B, self.sampler.atmospheres, (1, B))  # a replayed draw too
         dtype = input.dtype  # float32 or float64 (forward refuses others)
         gate = params["batch_prob"].reshape(-1).cpu() > 0.5 if "batch_prob" in params else torch.ones(B, dtype=torch.bool)
         if gate.numel() == 1:
@@ -994,9 +1042,11 @@ class RandomSeaClip(_Seas, torch.nn.Module):
                 params = self.generate_parameters(B)
         finally:
             self._call_generator = None
+        _check_params(params, B, self.sampler.atmospheres, (B,))  # a replayed draw too
         self._params = params
         out = x.clone()
-        gate = params["batch_prob"].reshape(-1).cpu() > 0.5
+        gate = (params["batch_prob"].reshape(-1).cpu() > 0.5 if "batch_prob" in params
+                else torch.ones(B, dtype=torch.bool))  # no gate: every clip, as kornia's RandomSeaBackground
         idx = gate.nonzero()[:, 0]
         if idx.numel() > 0:
             sub = {k: v[idx.to(v.device)] for k, v in params.items() if isinstance(v, torch.Tensor) and v.ndim == 1 and v.shape[0] == B}

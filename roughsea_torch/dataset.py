@@ -328,10 +328,16 @@ def frame_render_parameters(meta: dict[str, Any], frame: int | None = None) -> d
     """The :func:`~roughsea_torch.augmentation.render_parameters` input (one image) of an item's
     metadata (as :class:`SeaShardDataset` yields it, or a shard's arrays at one index), for a
     still image or, with ``frame``, frame ``frame`` of a clip: its pose and time replaced by the
-    frame's. A day item (``is_day`` in its metadata, ``scene.daytime`` > 0) also gives ``is_day``,
-    ``sun_elevation_deg`` and ``sun_azimuth_deg`` (world). The atmosphere stays a name
-    (``"atmosphere_name"``): map it to an index into the atmospheres you render with. The sensor noise of the frame is ``frame_noise_seed[frame]`` (a
-    still: ``noise_seed``)."""
+    frame's.
+
+    Returns a dict of tensors of shape (1,): the scene fields of :data:`SCENE_FIELDS` (float64),
+    ``noise_seed`` (int64: the item's, or with ``frame`` the frame's ``frame_noise_seed[frame]``,
+    the seed of that frame's sensor noise); a textured item (``wave_seed`` in its metadata) also
+    gives ``wave_seed`` (int64) and ``time_s`` (float64 [s], the frame's with ``frame``); a day item
+    (``is_day`` in its metadata, ``scene.daytime`` > 0) also ``is_day``, ``sun_elevation_deg`` and
+    ``sun_azimuth_deg`` (world). The atmosphere is NOT in it (``render_parameters`` needs it as an
+    index, which depends on the atmospheres you render with): the metadata's ``"atmosphere"`` is
+    its name, so add ``p["atmosphere"] = torch.tensor([atmospheres.index(meta["atmosphere"])])``."""
     p = {k: torch.tensor([float(meta[k])], dtype=torch.float64) for k, *_r in SCENE_FIELDS}
     if "wave_seed" in meta:
         p["wave_seed"] = torch.tensor([int(meta["wave_seed"])], dtype=torch.int64)

@@ -19,6 +19,7 @@ import torch
 
 from ._validation import check_finite_range
 from .geometry import make_camera
+from .waves import check_time
 
 __all__ = ["PlatformMotion", "render_clip"]
 
@@ -66,8 +67,8 @@ class PlatformMotion:
             raise ValueError("heave_amplitude_m: must stay below altitude_m (the sensor must stay above the sea)")
 
     def pose(self, time_s: Any) -> dict[str, Any]:
-        """Pitch, roll [deg] and altitude [m] at ``time_s`` [s] (float or (B,))."""
-        check_finite_range("time_s", time_s, unit="s")
+        """Pitch, roll [deg] and altitude [m] at ``time_s`` [s] (float or (B,), in [−1e9, 1e9])."""
+        check_time("time_s", time_s)
         t = time_s
 
         def osc(amp: Any, period: Any, extra: float = 0.0) -> Any:
@@ -103,21 +104,34 @@ def render_clip(
             kornia cameras (a still sensor).
         scene: a :class:`~roughsea_torch.SeaScene`; with ``seed=`` the sea moves (one realization
             advanced by the dispersion relation), without it every frame is the expectation image.
-        times_s: frame times [s], T of them (e.g. ``torch.arange(T) / fps``).
-        start_s: added to the scene's own ``time_s`` (float or (B,), e.g. a different start per
-            image); default the scene's ``time_s``.
+        times_s: frame times [s], T of them (e.g. ``torch.arange(T) / fps``): a number, or a
+            1-D sequence / tensor of real numbers (a 2-D one is a ``ValueError``, not flattened).
+            They are also the times at which ``cameras`` (a motion or callable) are posed.
+        start_s: the sea's time at ``times_s`` = 0 (float or (B,), e.g. a different start per
+            image): frame t shows the sea at ``start_s + times_s[t]``; default the scene's ``time_s``.
         progress: a tqdm progress bar over the frames.
         **render_kwargs: passed to :func:`~roughsea_torch.render` (``output=`` ...).
 
     Returns:
         (B, T, 1, H, W), kornia's video layout (``VideoSequential(data_format="BTCHW")``).
+
+    Times: ``start_s``, ``times_s`` and every frame's ``start_s + times_s[t]`` must be finite and
+    within [−1e9, 1e9] s (``roughsea_torch.waves.MAX_TIME_S``, the range ``SeaScene(time_s=)`` and
+    ``WaveField.sample`` accept), else a ``ValueError`` naming the argument.
     """
     from .render import render
 
-    times = torch.as_tensor(times_s, dtype=torch.float64).reshape(-1)
-    if times.numel() == 0 or not bool(torch.isfinite(times).all()):
-        raise ValueError("times_s: must be a non-empty sequence of finite times [s]")
+    check_time("times_s", times_s)
+    times = torch.as_tensor(times_s.detach() if isinstance(times_s, torch.Tensor) else times_s, dtype=torch.float64)
+    if times.ndim > 1 or times.numel() == 0:
+        raise ValueError(f"times_s: must be a non-empty 1-D sequence of times [s]; got shape {tuple(times.shape)}")
+    times = times.reshape(-1)
+    if start_s is not None:
+        check_time("start_s", start_s)
     base = scene.time_s if start_s is None else start_s
+    base64 = base.detach().double().cpu() if isinstance(base, torch.Tensor) else torch.as_tensor(base, dtype=torch.float64)
+    check_time("start_s + times_s" if start_s is not None else "scene.time_s + times_s",
+               base64.reshape(-1, 1) + times)  # every frame's time
     frames = []
     it = times.tolist()
     if progress:

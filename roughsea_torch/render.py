@@ -47,6 +47,7 @@ from .optics import band_refractive_index, split_refractive_index
 from .radiometry import LWIR, SpectralBand, as_band, band_radiance, brightness_temperature
 from .sky import ConstantSky, TabulatedSky, as_sky, select_sky
 from .slopes import SlopeStatistics
+from .waves import MAX_WIND_DIRECTION, _seeds, check_time
 
 __all__ = ["SeaScene", "render", "SeaRenderer", "TableSize"]
 
@@ -81,7 +82,8 @@ class SeaScene:
     Args:
         slopes: explicit :class:`SlopeStatistics` (fields of shape () or (B,)); or
         wind_speed: W [m s⁻¹] at 12.5 m → Cox–Munk slopes (``anisotropic`` selects the law).
-        wind_direction: world azimuth of the upwind axis x_s [rad] (from +x towards +y).
+        wind_direction: world azimuth of the upwind axis x_s [rad] (from +x towards +y), in
+            [−MAX_WIND_DIRECTION, MAX_WIND_DIRECTION] = [−1e6, 1e6] (as ``WaveField``).
         sea_temperature: T_sea [K] → R_B = band radiance; or
         sea_radiance: R_B [W m⁻² sr⁻¹] directly.
         band: sensor band (λ_lo, λ_hi) [m] or :class:`~roughsea_torch.radiometry.SpectralBand`.
@@ -113,15 +115,19 @@ class SeaScene:
             → B(T_air)) and first-order right for thin emission from near-surface air (the LWIR
             window's water vapour); it does not change the transmittance.
         seed: ``None`` (default): the expectation image, the mean over the sea's slope statistics.
-            An int, or one int per image (sequence or (B,) tensor): a textured sea, that
-            realization of a :class:`~roughsea_torch.waves.WaveField` (Elfouhaily spectrum at
-            ``wind_speed``, so ``wind_speed=`` is needed), rendered two-scale
+            An int (Python or numpy integer, or a 0-D integer tensor), or one int per image (a
+            sequence, (B,) integer tensor or array of exactly B ints; a ``ValueError`` otherwise),
+            each in [0, 2**63): a textured sea, that realization of a
+            :class:`~roughsea_torch.waves.WaveField` (Elfouhaily spectrum at ``wind_speed``, so
+            ``wind_speed=`` is needed), rendered two-scale
             (:mod:`roughsea_torch.clutter`): waves longer than a pixel's footprint are geometry,
             the rest stays in the expectation with the slope covariance left over. With one int
             for B > 1 images, image i gets the seed derived from (seed, i); give one seed per
             image for frames that do not depend on how a batch is split.
-        time_s: time of the realization [s], float or (B,); waves move by their dispersion
-            relation, so one seed at successive times is a coherent clip.
+        time_s: time of the realization [s], float or (B,) tensor, finite and in
+            [−MAX_TIME_S, MAX_TIME_S] = [−1e9, 1e9] s (the range ``WaveField.sample`` accepts; checked
+            whenever it is set); waves move by their dispersion relation, so one seed at successive
+            times is a coherent clip.
         sun: ``None`` (default, night or an overcast sun) or a :class:`~roughsea_torch.sun.Sun`
             whose ``azimuth`` is a WORLD azimuth [rad] (from +x towards +y, like the camera's yaw)
             and ``irradiance`` the direct irradiance at the surface in the scene's band [W m⁻²]
@@ -196,7 +202,7 @@ class SeaScene:
             slopes = SlopeStatistics.cox_munk(wind_speed, anisotropic=anisotropic)
         if not isinstance(slopes, SlopeStatistics):
             raise ValueError(f"slopes must be a SlopeStatistics; got {type(slopes).__name__}")
-        check_finite_range("wind_direction", wind_direction, unit="rad")
+        check_finite_range("wind_direction", wind_direction, -MAX_WIND_DIRECTION, MAX_WIND_DIRECTION, unit="rad")
         if sea_temperature is not None:
             check_finite_range("sea_temperature", sea_temperature, 200.0, 350.0, unit="K")
         if sea_radiance is not None:
@@ -241,12 +247,9 @@ class SeaScene:
             if wind_speed is None:
                 raise ValueError("seed: a textured sea needs wind_speed= (the wave spectrum is driven by the wind); "
                                  "seed=None renders the expectation image of slopes=")
-            seeds = seed.tolist() if isinstance(seed, torch.Tensor) else seed
-            seeds = [seeds] if not isinstance(seeds, (list, tuple, np.ndarray)) else list(seeds)
-            if not seeds or not all(isinstance(v, int) and not isinstance(v, bool) and 0 <= v < 2**63 for v in seeds):
-                raise ValueError(f"seed must be None, an int in [0, 2**63) or a sequence of such ints (one per image); got {seed!r}")
-            seed = seeds[0] if (isinstance(seed, int)) else seeds
-        check_finite_range("time_s", time_s, unit="s")
+            parsed = _seeds(seed)  # WaveField's check: ints in [0, 2**63), numpy integers too
+            seed = parsed.values[0] if parsed.single else list(parsed.values)
+        self.time_s = time_s  # checked by its setter
         if sun is not None:
             from .sun import Sun
 
@@ -281,8 +284,22 @@ class SeaScene:
             check_finite_range("foam", foam, 0.0, 1.0)
         self.foam = foam
         self.seed = seed
-        self.time_s = time_s
         self._wave_fields: dict[Any, Any] = {}
+
+    @property
+    def time_s(self) -> Any:
+        """Time of the realization [s]: a float or (B,) tensor/array in [−MAX_TIME_S, MAX_TIME_S]."""
+        return self._time_s
+
+    @time_s.setter
+    def time_s(self, value: Any) -> None:  # checked on every assignment (render_clip sets each frame's)
+        if isinstance(value, (list, tuple)):
+            raise ValueError("time_s: give a float or a tensor of shape (B,), one time per image; got a "
+                             f"{type(value).__name__} (use torch.tensor(...))")
+        check_time("time_s", value)
+        if isinstance(value, (torch.Tensor, np.ndarray)) and value.ndim > 1:
+            raise ValueError(f"time_s: must be a float or a tensor of shape (B,); got shape {tuple(value.shape)}")
+        self._time_s = value
 
     @property
     def sun(self) -> Any:
@@ -352,17 +369,22 @@ class SeaScene:
             )
             if isinstance(v, torch.Tensor) and v.ndim > 0
         }
-        if isinstance(self.seed, list) and len(self.seed) > 1:
+        if isinstance(self.seed, list):  # one seed per image: a list of 1 is a batch of 1, not a broadcast
+            if len(sizes) == 1:
+                self.seeds(next(iter(sizes)))  # ValueError naming seed, B and its length if they differ
             sizes.add(len(self.seed))
         if len(sizes) > 1:
             raise ValueError(f"SeaScene: fields disagree on the batch size: {sorted(sizes)}")
         return sizes.pop() if sizes else 1
 
     def seeds(self, B: int) -> list[int]:
-        """One seed per image: the given ones, or for one int ``seed`` with B > 1 images, image i's
-        from numpy's ``SeedSequence((seed, i))``."""
+        """One seed per image: the given ones (exactly B of them), or for one int ``seed`` with B > 1
+        images, image i's from numpy's ``SeedSequence((seed, i))``."""
         if isinstance(self.seed, list):
-            return self.seed * B if len(self.seed) == 1 else list(self.seed)
+            if len(self.seed) != B:
+                raise ValueError(f"seed: a sequence of seeds needs one per image, B = {B}; got {len(self.seed)} "
+                                 "(give B seeds, or one int seed for seeds derived per image)")
+            return list(self.seed)
         if B == 1:
             return [int(self.seed)]
         return [int(np.random.SeedSequence((int(self.seed), i)).generate_state(1, np.uint64)[0] >> 1) for i in range(B)]
@@ -397,6 +419,8 @@ class SeaScene:
         own = self.batch_size
         if own not in (1, B):
             raise ValueError(f"SeaScene has batch size {own} but the cameras have {B}")
+        if isinstance(self.seed, list):
+            self.seeds(B)  # exactly B seeds, checked before any work
         vx, vy, cxy = (per_batch("slopes", v, B, dtype, device) for v in self.slopes.tensors(dtype, device))
         wd = per_batch("wind_direction", self.wind_direction, B, dtype, device)
         if self.sea_radiance is not None:
@@ -931,13 +955,17 @@ def render(
         quadrature: accuracy control of the model (default for the dtype).
         geometry: a precomputed :func:`view_geometry` of these cameras (reused across scenes).
         chunk: images whose per-pixel temporaries are held at once (memory bound; results do not
-            depend on it); default 4, and 1 for textured scenes (``seed=``), whose per-pixel work
-            holds a dozen more full-size temporaries.
+            depend on it), an int ≥ 1 (else a ``ValueError``); default 4, and 1 for textured scenes
+            (``seed=``), whose per-pixel work holds a dozen more full-size temporaries.
 
     Returns:
         (B, 1, H, W) tensor in the cameras' dtype and device; differentiable with respect to every
         tensor of the scene and of the cameras' pose.
     """
+    if chunk is not None:
+        if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
+            raise ValueError(f"chunk must be None or an int in [1, inf) (images per chunk); got {chunk!r}")
+        chunk = int(chunk)
     # a render of one chunk (a small batch) on one intra-op thread, its preparation included: with
     # torch's second thread its many small operations ran 0.5-0.9x as fast beside a busy process
     # (roughsea_torch._parallel); larger batches spread their chunks over worker threads instead

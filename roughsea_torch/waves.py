@@ -94,6 +94,8 @@ K_M = 370.0  # k_m, wavenumber of the phase-speed minimum [rad m⁻¹] (ECKV tex
 C_M = 0.23  # c_m, minimum phase speed [m s⁻¹] (ECKV text below Eq. 40)
 VON_KARMAN = 0.41  # κ in u* = κ U10 / ln(10/z0) (ECKV Eq. 60)
 MAX_WIND = 80.0  # [m s⁻¹] upper bound accepted for U10
+MAX_TIME_S = 1e9  # [s] |time| of a realization: WaveField.sample, SeaScene(time_s=), render_clip
+MAX_WIND_DIRECTION = 1e6  # [rad] |wind direction| accepted by WaveField and SeaScene
 _A0 = math.log(2.0) / 4.0  # a_0 (ECKV Eq. 59)
 _AP = 4.0  # a_p (ECKV Eq. 59)
 CREST_CUTOFF = 10.0  # k_b / k_p of the crest variable's low pass (WaveField docstring, *Crest variable*)
@@ -130,6 +132,12 @@ def _check_wind(name: str, wind_speed: Any) -> None:
             "render the expectation alone (the statistical slope model) instead of a WaveField"
         )
     check_finite_range(name, wind_speed, 0.0, MAX_WIND, lo_open=True, unit="m/s")
+
+
+def check_time(name: str, time_s: Any) -> None:
+    """``ValueError`` naming ``name`` unless ``time_s`` is a number or tensor of times in
+    [−MAX_TIME_S, MAX_TIME_S] [s] (finite): the times a wave field is sampled at."""
+    check_finite_range(name, time_s, -MAX_TIME_S, MAX_TIME_S, unit="s")
 
 
 def _check_wave_age(inverse_wave_age: Any) -> None:
@@ -370,7 +378,8 @@ class WaveField:
         wind_speed: U10 [m s⁻¹] in (0, 80]; float or tensor (B,). Differentiable (the Fourier
             amplitudes are √(F Δk²) of the spectrum at this wind; the random draws are fixed).
             0 raises: a calm sea has no texture, render the expectation alone.
-        seed: an int (then B = 1) or a sequence / 1-D integer tensor of B ints in [0, 2**63).
+        seed: an int (then B = 1; a numpy integer or 0-D integer tensor/array counts as one) or a
+            sequence / 1-D integer tensor or array of B ints, each in [0, 2**63).
         wind_direction: world azimuth of the UPWIND slope axis x_s [rad] (``docs/physics.md`` §2);
             float or (B,). The waves travel DOWNWIND, towards azimuth ``wind_direction + π``.
         inverse_wave_age: Ω_c in [0.84, 5]; float or (B,).
@@ -518,7 +527,7 @@ class WaveField:
             raise ValueError(f"bands must be a WaveBands; got {type(bands).__name__}")
         seeds = _seeds(seed)
         _check_wind("wind_speed", wind_speed)
-        check_finite_range("wind_direction", wind_direction, -1e6, 1e6, unit="rad")
+        check_finite_range("wind_direction", wind_direction, -MAX_WIND_DIRECTION, MAX_WIND_DIRECTION, unit="rad")
         _check_wave_age(inverse_wave_age)
         tensor_device = check_same_device(
             wind_speed=wind_speed, wind_direction=wind_direction, inverse_wave_age=inverse_wave_age
@@ -807,7 +816,7 @@ class WaveField:
         Args:
             x, y: world coordinates [m], tensors of shape (B, ...) (broadcast together; row i holds
                 the points of image i); finite. Gradients flow to them (pose gradients).
-            time_s: time [s], float or (B,).
+            time_s: time [s], float or (B,), in [−MAX_TIME_S, MAX_TIME_S] = [−1e9, 1e9] (finite).
             footprint: None (every band at full weight) or the pixel footprint f [m] per point,
                 a tensor broadcastable to x, ≥ 0, inf allowed: each band is multiplied by
                 :meth:`band_weights` (f). Differentiable.
@@ -837,7 +846,7 @@ class WaveField:
         for name, t in (("x", xt), ("y", yt)):
             if t.numel() and not bool(torch.isfinite(t.detach()).all()):
                 raise ValueError(f"{name} must be finite world coordinates [m] (no NaN or inf)")
-        check_finite_range("time_s", time_s, -1e9, 1e9, unit="s")
+        check_time("time_s", time_s)
         t_s = per_batch("time_s", time_s, self.batch_size, torch.float64, self.device)
         f = None
         if footprint is not None:
@@ -964,16 +973,20 @@ class _Seeds:
 def _seeds(seed: Any) -> _Seeds:
     if isinstance(seed, bool):
         raise ValueError("seed must be an int or a sequence / 1-D integer tensor of B ints; got a bool")
-    if isinstance(seed, Integral):
+    if isinstance(seed, Integral):  # Python and numpy integers (np.int64 from a shard)
         values, single = [int(seed)], True
     elif isinstance(seed, torch.Tensor):
-        if seed.dtype.is_floating_point or seed.dtype.is_complex or seed.dtype == torch.bool or seed.ndim != 1:
+        if seed.dtype.is_floating_point or seed.dtype.is_complex or seed.dtype == torch.bool or seed.ndim > 1:
             raise ValueError(
-                f"seed: a tensor of seeds must be 1-D with an integer dtype; got {seed.dtype} of shape {tuple(seed.shape)}"
+                f"seed: a tensor of seeds must be 0-D or 1-D with an integer dtype; got {seed.dtype} of shape {tuple(seed.shape)}"
             )
-        values, single = [int(v) for v in seed.tolist()], False
+        values, single = ([int(seed)], True) if seed.ndim == 0 else ([int(v) for v in seed.tolist()], False)
+    elif isinstance(seed, np.ndarray) and seed.ndim == 0:  # a 0-D array is one seed, as a numpy integer
+        return _seeds(seed[()])
     elif isinstance(seed, (Sequence, np.ndarray)) and not isinstance(seed, (str, bytes)):
-        items = np.asarray(seed).reshape(-1).tolist() if isinstance(seed, np.ndarray) else list(seed)
+        if isinstance(seed, np.ndarray) and seed.ndim != 1:
+            raise ValueError(f"seed: an array of seeds must be 1-D (one per image); got shape {seed.shape}")
+        items = seed.tolist() if isinstance(seed, np.ndarray) else list(seed)
         values = []
         for v in items:
             if isinstance(v, bool) or not isinstance(v, Integral):
