@@ -50,7 +50,7 @@ from .expectation import Quadrature
 from .geometry import EARTH_RADIUS_M, make_camera
 from .motion import PlatformMotion
 from .radiometry import LWIR, as_band, band_radiance, brightness_temperature
-from .render import SeaScene, TableSize, _chunk_images, render
+from .render import SeaScene, TableSize, _chunk_images, check_foam, render
 from .sensor import SensorModel
 from .waves import check_time
 
@@ -418,6 +418,7 @@ def _render_frames(
     quadrature: Quadrature | None,
     earth_radius_m: float,
     path: bool,
+    foam: Any = "auto",
 ) -> torch.Tensor:
     """(B, T, 1, H, W): frame t of image b from the fields of ``params`` (B,), with pose and time
     from ``frames`` (B, T). Images are grouped by atmosphere and by textured or not; a group's
@@ -463,7 +464,7 @@ def _render_frames(
             sea_temperature=f("sea_temperature"), air_temperature=f("air_temperature"), band=band,
             sky=atmospheres[a], path=None if path else False,
             seed=[int(s) for s in params["wave_seed"][idx.to(params["wave_seed"].device)].tolist()] if tex else None,
-            **sun,
+            foam=foam, **sun,
         ), device)
         pose = {name: f(name, frames) for name in ("pitch_deg", "roll_deg", "altitude_m", "time_s")}
         cam = dict(hfov_deg=f("hfov_deg"), yaw_deg=f("yaw_deg"))
@@ -506,6 +507,7 @@ def render_parameters(
     quadrature: Quadrature | None = None,
     earth_radius_m: float = EARTH_RADIUS_M,
     path: bool = True,
+    foam: Any = "auto",
 ) -> torch.Tensor:
     """The deterministic half: render the radiance images (B, 1, H, W) [W m⁻² sr⁻¹] that a set of
     :class:`SceneSampler` parameters describes (images sharing an atmosphere are rendered
@@ -519,13 +521,14 @@ def render_parameters(
     is True: ``SeaScene(sun_zenith=(90° − sun_elevation_deg), sun_azimuth=sun_azimuth_deg)`` (world
     azimuth; radians), its direct irradiance from the image's atmosphere's LOWTRAN7 table; the
     other images are by night, as without it. Motion fields, if present, are not used: a still
-    image is at the mean pose."""
+    image is at the mean pose. ``foam``: the scenes' whitecaps (``SeaScene(foam=)``: ``"auto"``,
+    ``False`` or a fraction in [0, 1])."""
     B = int(params["wind_speed"].shape[0])
     frames = {k: params[k].detach().cpu().to(torch.float64)[:, None] for k in ("pitch_deg", "roll_deg", "altitude_m")}
     frames["time_s"] = (params["time_s"].detach().cpu().to(torch.float64) if "time_s" in params
                         else torch.zeros(B, dtype=torch.float64))[:, None]
     return _render_frames(params, frames, height, width, atmospheres, band, anisotropic, dtype, device, table,
-                          quadrature, earth_radius_m, path)[:, 0]
+                          quadrature, earth_radius_m, path, check_foam(foam))[:, 0]
 
 
 def render_clip_parameters(
@@ -544,14 +547,16 @@ def render_clip_parameters(
     quadrature: Quadrature | None = None,
     earth_radius_m: float = EARTH_RADIUS_M,
     path: bool = True,
+    foam: Any = "auto",
 ) -> torch.Tensor:
     """Render clips (B, T, 1, H, W) [W m⁻² sr⁻¹], kornia's video layout: clip b's frame t is its
     sea at time ``time_s`` + t / ``frame_rate`` [s] seen from the pose of :func:`frame_parameters`
     (the platform's oscillations at t / ``frame_rate``). Frame t equals :func:`render_parameters`
-    of the clip's fields with that frame's pose and time (up to how images are batched)."""
+    of the clip's fields with that frame's pose and time (up to how images are batched); ``foam`` as
+    there."""
     frames = frame_parameters(params, num_frames, frame_rate)
     return _render_frames(params, frames, height, width, atmospheres, band, anisotropic, dtype, device, table,
-                          quadrature, earth_radius_m, path)
+                          quadrature, earth_radius_m, path, check_foam(foam))
 
 
 def _worker_stream(generator: torch.Generator, worker_id: int) -> torch.Generator:
@@ -737,6 +742,10 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
         output: ``"radiance"``, ``"brightness_temperature"`` [K], or ``"sensor"`` (the sensor
             model's output, e.g. counts; the default when a sensor is given).
         table, quadrature, path: renderer settings (see :func:`~roughsea_torch.render.render`).
+        foam: the whitecaps, as ``SeaScene(foam=)``: ``"auto"`` (default: Monahan's fraction at
+            each image's wind, on the crests of a textured sea), ``False`` (none: a sea without
+            whitecaps, e.g. where the model's dark whitecaps near grazing are not wanted;
+            README, *Foam*) or a fraction in [0, 1]. A setting of the augmentation, not drawn.
         generator: a CPU ``torch.Generator`` used for every draw of this instance when ``forward``
             gets none; ``forward(x, generator=g)`` seeds one call. Inside a
             ``torch.utils.data.DataLoader`` worker, each worker replaces it on first use by its own
@@ -796,6 +805,7 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
         table: TableSize = TableSize(),
         quadrature: Quadrature | None = None,
         path: bool = True,
+        foam: Any = "auto",
         generator: torch.Generator | None = None,
         p: float = 1.0,
         same_on_batch: bool = False,
@@ -819,6 +829,7 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
         self.table = table
         self.quadrature = quadrature
         self.path = path
+        self.foam = check_foam(foam)
         self.generator = generator
         self._call_generator: torch.Generator | None = None
         self._worker: tuple[tuple[int, int], torch.Generator] | None = None
@@ -864,7 +875,7 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
         sub = {k: v[idx.to(v.device)] for k, v in params.items() if isinstance(v, torch.Tensor) and v.ndim == 1 and v.shape[0] == B}
         L = render_parameters(
             sub, H, W, self.sampler.atmospheres, band=self.band, anisotropic=self.anisotropic, dtype=dtype,
-            device=input.device, table=self.table, quadrature=self.quadrature, path=self.path,
+            device=input.device, table=self.table, quadrature=self.quadrature, path=self.path, foam=self.foam,
         )
         # compositing and the sensor on one intra-op thread (as the scenes above)
         L = one_thread(lambda: self._finish(L, input[idx], sub["noise_seed"].tolist()), input.device).to(input.dtype)
@@ -906,7 +917,7 @@ class RandomSeaClip(_Seas, torch.nn.Module):
             :class:`RandomSeaBackground` (drawn per clip; the sun stays put over a clip, its
             relative azimuth from the clip's mean yaw).
         wind_speed, ..., hfov_deg, atmospheres, band, anisotropic, mode, target_unit, sensor,
-            output, table, quadrature, path, generator: as :class:`RandomSeaBackground`. In
+            output, table, quadrature, path, foam, generator: as :class:`RandomSeaBackground`. In
             composite mode every frame holds its own target and opacity (C = 2). With a sensor,
             frame t's temporal noise comes from :func:`frame_noise_seed` (noise_seed, t); the fixed
             pattern is the same on every frame.
@@ -969,6 +980,7 @@ class RandomSeaClip(_Seas, torch.nn.Module):
         table: TableSize = TableSize(),
         quadrature: Quadrature | None = None,
         path: bool = True,
+        foam: Any = "auto",
         generator: torch.Generator | None = None,
         p: float = 1.0,
         same_on_batch: bool = False,
@@ -1003,6 +1015,7 @@ class RandomSeaClip(_Seas, torch.nn.Module):
         self.table = table
         self.quadrature = quadrature
         self.path = path
+        self.foam = check_foam(foam)
         self.generator = generator
         self.p = float(p)
         self.same_on_batch = same_on_batch
@@ -1052,7 +1065,7 @@ class RandomSeaClip(_Seas, torch.nn.Module):
             sub = {k: v[idx.to(v.device)] for k, v in params.items() if isinstance(v, torch.Tensor) and v.ndim == 1 and v.shape[0] == B}
             frames = frame_parameters(sub, T, self.frame_rate)
             L = _render_frames(sub, frames, H, W, self.sampler.atmospheres, self.band, self.anisotropic, x.dtype,
-                               x.device, self.table, self.quadrature, EARTH_RADIUS_M, self.path)
+                               x.device, self.table, self.quadrature, EARTH_RADIUS_M, self.path, self.foam)
             n = idx.numel()
             L = one_thread(lambda: self._finish(L.reshape(n * T, 1, H, W), x[idx].reshape(n * T, C, H, W),  # as above
                                                 frames["noise_seed"].reshape(-1).tolist()), x.device)

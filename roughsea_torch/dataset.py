@@ -29,7 +29,8 @@ clip, frame t at ``time_s`` + t / ``frame_rate`` [s], seen from a camera on a
 from the ``[motion]`` ranges (:data:`~roughsea_torch.augmentation.MOTION_FIELDS`). Every frame is
 re-rendered exactly by :func:`~roughsea_torch.augmentation.render_parameters` of its item's fields
 with ``pitch_deg``, ``roll_deg``, ``altitude_m``, ``time_s`` replaced by the frame's, and its
-sensor noise drawn from ``frame_noise_seed``.
+sensor noise drawn from ``frame_noise_seed`` (with the config's ``scene.band``, ``anisotropic``,
+``path`` and ``foam``; ``foam = false`` leaves the whitecaps out, ``"auto"`` is the default).
 
 Determinism: item i (image or clip) is made only from (seed, i) (its parameters, wave seed,
 motion and noise streams come from
@@ -66,6 +67,7 @@ from .augmentation import (
     render_parameters,
 )
 from .radiometry import LWIR, MWIR, SpectralBand, as_band
+from .render import check_foam
 
 __all__ = ["DEFAULT_CONFIG", "resolve_config", "build_sensor", "generate", "SeaShardDataset", "shard_name",
            "frame_render_parameters"]
@@ -80,7 +82,7 @@ DEFAULT_CONFIG: dict[str, Any] = {
     "frame_rate": 25.0,
     "camera": {"height": 512, "width": 640},
     "scene": {"atmospheres": ["midlatitude_summer"], "band": "LWIR", "anisotropic": True, "path": True,
-              "texture": True, "time_s": list(DEFAULT_TIME_S),
+              "foam": "auto", "texture": True, "time_s": list(DEFAULT_TIME_S),
               "daytime": 0.0, **{name: list(d) for name, _a, _u, d in SUN_FIELDS}, "sun_azimuth_relative_to_yaw": True,
               **{name: (list(d) if isinstance(d, tuple) else d) for name, _a, _u, d in SCENE_FIELDS}},
     "motion": {name: list(d) for name, _a, _u, d in MOTION_FIELDS},
@@ -111,7 +113,8 @@ def _sampler(scene: dict[str, Any], motion: dict[str, Any] | None = None) -> Sce
     """The SceneSampler of a config's ``scene`` table (its ranges, checked against the path tables
     when ``path`` is on; ``anisotropic`` aside), with the ``motion`` ranges for clips."""
     return SceneSampler(band=_band(scene["band"]), motion=motion,
-                        **{k: (tuple(v) if isinstance(v, list) else v) for k, v in scene.items() if k not in ("band", "anisotropic")})
+                        **{k: (tuple(v) if isinstance(v, list) else v) for k, v in scene.items()
+                           if k not in ("band", "anisotropic", "foam")})
 
 
 def _config_sampler(cfg: dict[str, Any]) -> SceneSampler:
@@ -184,6 +187,12 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
     for key in ("anisotropic", "path", "texture", "sun_azimuth_relative_to_yaw"):
         if not isinstance(sc[key], bool):
             raise ValueError(f"config: scene.{key} must be true or false; got {sc[key]!r}")
+    if sc["foam"] is True or not (sc["foam"] in ("auto", False) or isinstance(sc["foam"], (int, float))):
+        raise ValueError(f"config: scene.foam must be \"auto\", false or a whitecap fraction in [0, 1]; got {sc['foam']!r}")
+    try:
+        check_foam(sc["foam"])
+    except ValueError as e:
+        raise ValueError(f"config: scene.{e}") from None
     try:
         _sampler(sc)
     except ValueError as e:
@@ -287,7 +296,8 @@ def render_shard(cfg: dict[str, Any], k: int, sensor: torch.nn.Module | None = N
     with torch.no_grad():
         for i in range(0, len(indices), bs):
             sub = {n: v[i : i + bs] for n, v in params.items()}
-            kw = dict(band=_band(sc["band"]), anisotropic=sc["anisotropic"], dtype=dtype, device=device, path=sc["path"])
+            kw = dict(band=_band(sc["band"]), anisotropic=sc["anisotropic"], dtype=dtype, device=device, path=sc["path"],
+                      foam=sc["foam"])
             if T > 1:
                 L = render_clip_parameters(sub, T, cfg["frame_rate"], H, W, sampler.atmospheres, **kw)
                 seeds = frames["noise_seed"][i : i + bs]

@@ -76,6 +76,19 @@ def _chunk_images(scene: Any, chunk: Any = None) -> Any:
 _CACHE_LOCK = threading.RLock()  # SeaScene's caches (skies, wave fields), filled from worker threads
 
 
+def check_foam(foam: Any) -> Any:
+    """``SeaScene``'s ``foam`` argument, normalized (``None`` for none), or a ``ValueError``: ``"auto"``,
+    ``False``/``None``, or a whitecap fraction in [0, 1] (float or (B,))."""
+    if foam is None or foam is False:
+        return None
+    if isinstance(foam, str):
+        if foam != "auto":
+            raise ValueError(f"foam must be 'auto', False or a fraction in [0, 1]; got {foam!r}")
+        return foam
+    check_finite_range("foam", foam, 0.0, 1.0)
+    return foam
+
+
 class SeaScene:
     """What is in front of the cameras, one value per image (floats or tensors of shape (B,)).
 
@@ -275,14 +288,7 @@ class SeaScene:
         self.sun_zenith, self.sun_azimuth = sun_zenith, sun_azimuth
         self.sun_masking = sun_masking
         self.sky_masking = bool(sky_masking)
-        if foam is None or foam is False:
-            foam = None
-        elif isinstance(foam, str):
-            if foam != "auto":
-                raise ValueError(f"foam must be 'auto', False or a fraction in [0, 1]; got {foam!r}")
-        else:
-            check_finite_range("foam", foam, 0.0, 1.0)
-        self.foam = foam
+        self.foam = check_foam(foam)
         self.seed = seed
         self._wave_fields: dict[Any, Any] = {}
 

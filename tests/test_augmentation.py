@@ -424,3 +424,26 @@ def test_altitudes_outside_the_path_tables_are_refused(altitude):
         make(altitude_m=(2.0, 5000.0))
     with pytest.raises(ValueError, match="altitude_m"):
         SceneSampler(altitude_m=(0.1, 10.0), path=False)  # below the sampler's own 0.5 m
+
+
+def test_foam_setting_reaches_the_rendered_seas():
+    """RandomSeaBackground(foam=False) renders seas without whitecaps (the user's switch for the
+    model's dark whitecaps near grazing): its images are render_parameters(..., foam=False) of its
+    draw, bitwise, and at 15 m/s they differ from the default's, which are colder at their coldest
+    sea pixel (the whitecaps). A bad setting is a ValueError naming foam."""
+    from roughsea_torch.augmentation import render_parameters
+
+    kw = dict(wind_speed=(15.0, 15.0), altitude_m=(15.0, 15.0), pitch_deg=(-6.0, -6.0), output="radiance")
+    x = torch.zeros(2, 1, 24, 32)
+    off = RandomSeaBackground(foam=False, **kw)
+    y_off = off(x, generator=torch.Generator().manual_seed(3))
+    assert torch.equal(y_off, render_parameters(off._params, 24, 32, off.sampler.atmospheres, foam=False))
+    on = RandomSeaBackground(**kw)
+    y_on = on(x, params=off._params)
+    assert torch.equal(y_on, render_parameters(off._params, 24, 32, off.sampler.atmospheres))
+    sea = rs.view_geometry(rs.make_camera(24, 32, hfov_deg=off._params["hfov_deg"], altitude_m=15.0,
+                                          pitch_deg=-6.0, yaw_deg=off._params["yaw_deg"],
+                                          roll_deg=off._params["roll_deg"])).is_sea[:, None]
+    assert float(y_on[sea].min()) < float(y_off[sea].min()) - 0.05  # W m-2 sr-1: the whitecaps
+    with pytest.raises(ValueError, match="foam"):
+        RandomSeaBackground(foam="yes")

@@ -338,3 +338,29 @@ def test_a_sensor_stage_left_out(tmp_path):
     a = torch.cat([s(L[i : i + 1], generator=torch.Generator().manual_seed(1)) for i in range(2)]).round()
     b = torch.cat([s(L[i : i + 1], generator=torch.Generator().manual_seed(2)) for i in range(2)]).round()
     assert torch.equal(a, b) and np.array_equal(a[:, 0].numpy().astype(np.int64), quiet)
+
+
+def test_foam_off_in_the_config_reaches_the_shards(tmp_path):
+    """scene.foam = false makes seas without whitecaps: a strong-wind image re-renders from its
+    metadata with render_parameters(..., foam=False), not with the default whitecaps; a bad value is
+    a config error naming scene.foam."""
+    cfg = dict(CFG, num_images=1, shard_size=1, scene=dict(CFG["scene"], wind_speed=[15.0, 15.0], foam=False))
+    generate(cfg, tmp_path, progress=False)
+    resolved = resolve_config(cfg)
+    assert resolved["scene"]["foam"] is False
+    sensor = build_sensor(resolved)
+    (img, meta), = list(SeaShardDataset(tmp_path))
+    atmospheres = ("tropical", "us_standard")
+    p = frame_render_parameters(meta)
+    p["atmosphere"] = torch.tensor([atmospheres.index(meta["atmosphere"])])
+
+    def counts(**kw):
+        L = render_parameters(p, 20, 28, atmospheres, **kw)
+        return sensor(L, generator=torch.Generator().manual_seed(int(meta["noise_seed"])))[0].round()
+
+    assert torch.equal(counts(foam=False), img)
+    assert not torch.equal(counts(), img)
+    with pytest.raises(ValueError, match="scene.foam"):
+        resolve_config(dict(CFG, scene=dict(CFG["scene"], foam="maybe")))
+    with pytest.raises(ValueError, match="scene.foam"):
+        resolve_config(dict(CFG, scene=dict(CFG["scene"], foam=1.5)))
