@@ -714,7 +714,8 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
             drawn after the other parameters and kept for replay. Images with ``wind_speed`` ≤
             :data:`CALM_WIND_SPEED` (a calm sea, no resolved waves) are the expectation image.
             ``False``: the expectation image (the mean over the slope statistics, Eq. 10), with
-            the same parameter draws as before texture existed.
+            the same parameter draws as before texture existed; also for a replayed draw that
+            holds wave seeds (e.g. one of a textured augmentation's ``_params``): the setting wins.
         time_s: range of the realizations' times [s] (default [0, 3600)); see :class:`SceneSampler`.
         daytime: probability in [0, 1] that an image is by day (default 0.0: all by night, and the
             draws as before this option). A day image has the sun in its sky at an elevation drawn
@@ -872,7 +873,8 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
         out = input.clone()
         if idx.numel() == 0:
             return out
-        sub = {k: v[idx.to(v.device)] for k, v in params.items() if isinstance(v, torch.Tensor) and v.ndim == 1 and v.shape[0] == B}
+        sub = {k: v[idx.to(v.device)] for k, v in params.items() if isinstance(v, torch.Tensor) and v.ndim == 1 and v.shape[0] == B
+               and (self.texture or k != "wave_seed")}  # texture=False: the expectation, whatever the draw holds
         L = render_parameters(
             sub, H, W, self.sampler.atmospheres, band=self.band, anisotropic=self.anisotropic, dtype=dtype,
             device=input.device, table=self.table, quadrature=self.quadrature, path=self.path, foam=self.foam,
@@ -910,8 +912,9 @@ class RandomSeaClip(_Seas, torch.nn.Module):
         pitch_period_s, roll_period_s, heave_period_s: ranges of the periods [s] (default 5–12 s,
             a ship's response to a swell).
         texture: ``True`` (default): a textured, moving sea; ``False``: every frame is the
-            expectation image of its pose (only the camera moves). Clips with ``wind_speed`` ≤
-            :data:`CALM_WIND_SPEED` are expectation images too.
+            expectation image of its pose (only the camera moves), also for a replayed draw that
+            holds wave seeds. Clips with ``wind_speed`` ≤ :data:`CALM_WIND_SPEED` are expectation
+            images too.
         time_s: range of the clips' start times [s] (default [0, 3600)).
         daytime, sun_elevation_deg, sun_azimuth_deg, sun_azimuth_relative_to_yaw: day clips, as
             :class:`RandomSeaBackground` (drawn per clip; the sun stays put over a clip, its
@@ -1062,7 +1065,8 @@ class RandomSeaClip(_Seas, torch.nn.Module):
                 else torch.ones(B, dtype=torch.bool))  # no gate: every clip, as kornia's RandomSeaBackground
         idx = gate.nonzero()[:, 0]
         if idx.numel() > 0:
-            sub = {k: v[idx.to(v.device)] for k, v in params.items() if isinstance(v, torch.Tensor) and v.ndim == 1 and v.shape[0] == B}
+            sub = {k: v[idx.to(v.device)] for k, v in params.items() if isinstance(v, torch.Tensor) and v.ndim == 1
+                   and v.shape[0] == B and (self.texture or k != "wave_seed")}  # texture=False: the expectation
             frames = frame_parameters(sub, T, self.frame_rate)
             L = _render_frames(sub, frames, H, W, self.sampler.atmospheres, self.band, self.anisotropic, x.dtype,
                                x.device, self.table, self.quadrature, EARTH_RADIUS_M, self.path, self.foam)

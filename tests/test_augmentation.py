@@ -447,3 +447,26 @@ def test_foam_setting_reaches_the_rendered_seas():
     assert float(y_on[sea].min()) < float(y_off[sea].min()) - 0.05  # W m-2 sr-1: the whitecaps
     with pytest.raises(ValueError, match="foam"):
         RandomSeaBackground(foam="yes")
+
+
+def test_texture_off_wins_over_a_replayed_textured_draw():
+    """RandomSeaBackground(texture=False) given a textured augmentation's draw (which holds wave
+    seeds) renders the expectation images of that draw (it rendered the textured seas); so does
+    RandomSeaClip(texture=False)."""
+    kw = dict(wind_speed=(8.0, 8.0), altitude_m=(10.0, 10.0), pitch_deg=(-8.0, -8.0), output="radiance")
+    x = torch.zeros(2, 1, 24, 32)
+    tex = RandomSeaBackground(**kw)
+    y_tex = tex(x, generator=torch.Generator().manual_seed(1))
+    assert "wave_seed" in tex._params
+    y_off = RandomSeaBackground(texture=False, **kw)(x, params=tex._params)
+    flat = {k: v for k, v in tex._params.items() if k != "wave_seed"}
+    assert torch.equal(y_off, render_parameters(flat, 24, 32, tex.sampler.atmospheres))
+    assert not torch.equal(y_off, y_tex)
+    clip_kw = kw
+    clip = rs.RandomSeaClip(**clip_kw)
+    v = torch.zeros(2, 2, 1, 24, 32)
+    v_tex = clip(v, generator=torch.Generator().manual_seed(1))
+    v_off = rs.RandomSeaClip(texture=False, **clip_kw)(v, params=clip._params)
+    assert not torch.equal(v_off, v_tex)
+    assert torch.equal(v_off, rs.RandomSeaClip(texture=False, **clip_kw)(v, params={k: w for k, w in clip._params.items()
+                                                                                   if k != "wave_seed"}))

@@ -191,3 +191,17 @@ def test_frame_render_parameters_docstring_matches_its_result():
     assert 'meta["atmosphere"]' in doc
     for key in set(p) - {name for name, *_r in D.SCENE_FIELDS}:
         assert f"``{key}``" in doc, key
+
+
+@pytest.mark.parametrize("kw,name", [(dict(pitch_deg=-89.5, pitch_amplitude_deg=1.0), "pitch_amplitude_deg"),
+                                     (dict(roll_deg=179.0, roll_amplitude_deg=2.0), "roll_amplitude_deg"),
+                                     (dict(hfov_deg=200.0), "hfov_deg")])
+def test_platform_motion_checks_its_poses_when_built(kw, name):
+    """A mast whose pose ± amplitude leaves the cameras' range is refused when it is built, naming
+    the amplitude (it was refused only at the first frame that left it, naming pitch_deg or
+    roll_deg); the poses it does accept all make cameras."""
+    with pytest.raises(ValueError, match=name):
+        rs.PlatformMotion(**kw)
+    ok = rs.PlatformMotion(pitch_deg=-88.0, pitch_amplitude_deg=2.0, roll_deg=178.0, roll_amplitude_deg=2.0)
+    for t in (1.5, 4.5, 0.0, 2.25):  # the extremes of pitch (period 6 s) and roll (9 s, phase π/2)
+        ok.cameras(t)
