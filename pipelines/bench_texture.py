@@ -84,6 +84,49 @@ def stages(cams, textured) -> list[tuple[str, float]]:
     return [("whole render", total)] + [(k, v) for k, v in sorted(ev.items()) if k != "render"]
 
 
+def band_reads(cams, textured) -> dict:
+    """What the wave field's band lookups cost in one textured render (1 thread): the number of
+    bilinear reads (point × channel) of the band tiles per pixel, and the time ``grid_sample``
+    takes over them (timed around each call of ``WaveField._sample_points``); and the same
+    kernel's cost per point for 1, 2 and 3 channels on random points of a doubled tile, which
+    shows whether channels or points set it."""
+    import torch.nn.functional as F
+
+    import roughsea_torch.waves as wv
+
+    class Timed:  # torch.nn.functional with grid_sample timed
+        def __init__(self):
+            self.t, self.reads = 0.0, 0
+
+        def __getattr__(self, name):
+            return getattr(F, name)
+
+        def grid_sample(self, tile, grid, *a, **k):
+            t0 = time.perf_counter()
+            out = F.grid_sample(tile, grid, *a, **k)
+            self.t += time.perf_counter() - t0
+            self.reads += grid.shape[0] * grid.shape[1] * grid.shape[2] * tile.shape[1]
+            return out
+
+    rs.render(cams, textured)
+    timed, orig = Timed(), wv.F_nn
+    wv.F_nn = timed
+    try:
+        rs.render(cams, textured)
+    finally:
+        wv.F_nn = orig
+    n = 2 * wv.WaveBands().tile_size + 1
+    points = 2**18
+    grid = torch.rand(1, 1, points, 2, generator=torch.Generator().manual_seed(0)) * 2 - 1
+    per_channel = {}
+    for c in (1, 2, 3):
+        tile = torch.randn(1, c, n, n)
+        per_channel[c] = med(lambda: F.grid_sample(tile, grid, mode="bilinear", padding_mode="border",
+                                                   align_corners=True), 15) / points * 1e9
+    pixels = B * H * W
+    return {"reads_per_pixel": timed.reads / pixels, "read_time": timed.t, "ns_per_point": per_channel}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
@@ -135,6 +178,20 @@ def main() -> None:
     torch.set_num_threads(1)
     lines += ["", "Where the textured render's time goes (1 thread, profiler CPU totals):", "", "| part | s |", "|---|---:|"]
     lines += [f"| {k} | {v:.3f} |" for k, v in stages(cams, tex_scene)]
+    # the floor that the band lookups set: the 3x goal leaves 2 expectation renders for all of the texture
+    reads = band_reads(cams, tex_scene)
+    t_mean1 = rows[0][1]
+    ns = reads["ns_per_point"]
+    lines += ["", "The wave field's band lookups (1 thread): bilinear reads of the band tiles, a point and a "
+              "channel each, timed in the render; `grid_sample`'s cost per point on a doubled 257×257 tile "
+              f"(random points, median of 15): {ns[1]:.1f} ns with 1 channel, {ns[2]:.1f} with 2, {ns[3]:.1f} "
+              "with 3, so channels, not points, set it.", "",
+              "| reads per pixel | time in grid_sample [s] | ns per read | that time / expectation render |",
+              "|---:|---:|---:|---:|",
+              f"| {reads['reads_per_pixel']:.1f} | {reads['read_time']:.3f} | "
+              f"{reads['read_time'] / (reads['reads_per_pixel'] * B * H * W) * 1e9:.2f} | "
+              f"{reads['read_time'] / t_mean1:.2f} |"]
+    print("\n".join(lines[-5:]), file=sys.stderr)
     report = "\n".join(lines) + "\n"
     print(report)
     out = Path(args.out)
