@@ -30,7 +30,7 @@ import os
 import threading
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 import torch
@@ -724,17 +724,20 @@ def _azimuth_centre(dx: torch.Tensor, dy: torch.Tensor, wind_direction: torch.Te
     return 0.5 * torch.atan2(torch.where(m, torch.sin(2 * ps), zero).sum((1, 2)), torch.where(m, torch.cos(2 * ps), zero).sum((1, 2)))
 
 
-def _azimuth_coordinate(dx: torch.Tensor, dy: torch.Tensor, offset: torch.Tensor, fold: bool) -> torch.Tensor:
+def _azimuth_coordinate(dx: torch.Tensor, dy: torch.Tensor, offset: torch.Tensor, fold: bool,
+                        period: float = math.pi) -> torch.Tensor:
     """The table's azimuth coordinate of each pixel, (b, H, W), from its ray's world x, y components.
 
     ``fold`` (uncorrelated slopes, ``offset`` = π/2 − wind direction): ψ = |φ̂| folded into
     [0, π/2] by the mirror symmetries R_a(φ̂) = R_a(−φ̂) = R_a(π − φ̂); otherwise (``offset`` =
-    π/2 − c − wind direction, c the image's centre azimuth): o = wrap_π(φ̂ − c) + π/2 ∈ [0, π)."""
+    π/2 − c − wind direction, c the image's centre azimuth): o = wrap_π(φ̂ − c) + π/2 ∈ [0, π),
+    R_a(φ̂ + π) = R_a(φ̂) for a sky the same in every azimuth. Under a day sky, which is not,
+    ``period`` = 2π (``offset`` = −c − wind direction): o = wrap_2π(φ̂ − c) + π ∈ [0, 2π)."""
     # atan2(dy, dx) is the ray's azimuth, the LOS's + π: the same modulo π. With the offset wrapped
-    # into [0, π) per image, (atan2 + offset)/π + 1 lies in [0, 3): its frac is the remainder
+    # into [0, P) per image, (atan2 + offset)/P + 1 lies in [0, 3): its frac is the remainder
     # (torch.remainder, a floor division, costs ~4x frac on the CPU)
-    start = (1.0 + torch.remainder(offset, math.pi) / math.pi).to(dy.dtype)[:, None, None]
-    o = torch.frac(torch.atan2(dy, dx).mul_(1.0 / math.pi).add_(start)).mul_(math.pi)
+    start = (1.0 + torch.remainder(offset, period) / period).to(dy.dtype)[:, None, None]
+    o = torch.frac(torch.atan2(dy, dx).mul_(1.0 / period).add_(start)).mul_(period)
     return (o - math.pi / 2).abs() if fold else o
 
 
@@ -830,7 +833,8 @@ def _asinh(x: torch.Tensor) -> torch.Tensor:
     return torch.log(x + torch.sqrt(x * x + 1.0))  # 3× faster than torch.asinh on CPU
 
 
-def _camera_ranges(cg: CameraGeometry, sl: slice, wd: torch.Tensor, inv_eps: torch.Tensor, iso: bool, fold: bool) -> _Ranges:
+def _camera_ranges(cg: CameraGeometry, sl: slice, wd: torch.Tensor, inv_eps: torch.Tensor, iso: bool, fold: bool,
+                   period: float = math.pi) -> _Ranges:
     """The spans of the images ``sl`` from the rays of their border alone (no per-pixel work).
 
     cos θ̂ of a sea pixel grows with −dz (the ray's local-vertical component), and dz and the LOS
@@ -838,7 +842,8 @@ def _camera_ranges(cg: CameraGeometry, sl: slice, wd: torch.Tensor, inv_eps: tor
     over the image they take their extremes on its border, unless a pole is in view. The sea pixels'
     azimuths span those of the sea part of the border plus the horizon arc, which is monotone in
     azimuth between its ends on the border. Spans are widened by one border step (the sampled border
-    against the continuous one).
+    against the continuous one). Unfolded, the coordinate o = wrap_P(φ̂ − c) + P/2 spans
+    P/2 ± half the pixels' span, or all of [0, P] (``period`` P: π, or 2π under a day sky).
     """
     with torch.no_grad():
         dz, dx, dy = (t.double() for t in cg.border(sl))
@@ -878,8 +883,8 @@ def _camera_ranges(cg: CameraGeometry, sl: slice, wd: torch.Tensor, inv_eps: tor
             return _Ranges((z_lo, z_hi), (s_lo, s_hi), any_sea, any_sky, (lo, hi), torch.zeros_like(lo))
         c = torch.where(full, torch.zeros_like(a), 0.5 * (a + b))
         half = 0.5 * (b - a)
-        lo = torch.where(full, torch.zeros_like(a), math.pi / 2 - half)
-        hi = torch.where(full, torch.full_like(b, math.pi), math.pi / 2 + half)
+        lo = torch.where(full, torch.zeros_like(a), period / 2 - half)
+        hi = torch.where(full, torch.full_like(b, period), period / 2 + half)
         return _Ranges((z_lo, z_hi), (s_lo, s_hi), any_sea, any_sky, (lo, hi), c)
 
 
@@ -1302,18 +1307,19 @@ def _glint_pixels(scene: SeaScene, p: dict[str, Any], sl: slice, cos_t: torch.Te
 
 
 def _glint_core_table(scene: SeaScene, p: dict[str, Any], sl: slice, eps: torch.Tensor, lo: torch.Tensor,
-                      span_z: torch.Tensor, y_z: torch.Tensor, u_ab: tuple[torch.Tensor, torch.Tensor], y_cols: torch.Tensor,
-                      centre: torch.Tensor, sea_cols: torch.Tensor, scale_rows: torch.Tensor | None, table: TableSize,
-                      dtype: torch.dtype) -> tuple[torch.Tensor, torch.Tensor]:
+                      span_z: torch.Tensor, y_z: torch.Tensor, col_angle: Callable[[torch.Tensor], torch.Tensor],
+                      y_cols: torch.Tensor, centre: torch.Tensor, shift: float, sea_cols: torch.Tensor,
+                      scale_rows: torch.Tensor | None, table: TableSize, dtype: torch.dtype) -> tuple[torch.Tensor, torch.Tensor]:
     """The smooth factor L_sun G1 / D of the glint of images ``sl`` (the glint is P ρ t · L_sun G1 / D,
     ``roughsea_torch.sun._glint_sharp`` the sharp part, which :func:`_glint_sharp_pixels` evaluates per
-    pixel) on the fine table's sea rows and (unfolded, ratio) columns, times ``scale_rows`` (b, M_z)
+    pixel) on the fine table's sea rows and unfolded columns (``col_angle``: the azimuth coordinate o of
+    column coordinates y ∈ [−1, 1], φ̂ = ``centre`` + o − ``shift``), times ``scale_rows`` (b, M_z)
     (the path's τ, the foam's 1 − f); (b, M_z, M_o), and which images it serves (b,) bool (zero for the
     others, whose glint stays wholly per pixel).
 
     The factor is evaluated at ``table.glint``² Chebyshev–Lobatto nodes (in ζ over the sea rows' span,
     in azimuth over every column) and resampled spectrally. An image is served when its pixels span
-    less than π in azimuth (the coordinate has period π, the glint has not) and, at the centres of the fine cells
+    less than π in azimuth (without a day sky the coordinate has period π, the glint has not) and, at the centres of the fine cells
     of 48 rows and every other column (where bilinear reading errs most), the table's glint is within
     ``table.glint_tolerance`` of direct evaluation, relative to the radiance there (``sea_cols``, the
     sea's fine table, plus the glint).
@@ -1334,7 +1340,7 @@ def _glint_core_table(scene: SeaScene, p: dict[str, Any], sl: slice, eps: torch.
 
     def angles(zeta: torch.Tensor, o: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:  # ζ (b, R), o (b, C), float64
         th = torch.acos((eps[:, None] * torch.sinh(zeta)).clamp(0.0, 1.0)).to(dtype)[:, :, None]
-        return th, (centre[:, None] + o - math.pi / 2).to(dtype)[:, None, :]
+        return th, (centre[:, None] + o - shift).to(dtype)[:, None, :]
 
     def smooth(th: torch.Tensor, ph: torch.Tensor) -> torch.Tensor:
         r = _glint(th, ph, per[0], per[1], per[2], None, None, per[3], per[4], tz, tp, e_sun, al, scene.shadowing,
@@ -1349,8 +1355,7 @@ def _glint_core_table(scene: SeaScene, p: dict[str, Any], sl: slice, eps: torch.
     xg, L_rows, _ = _lobatto_interp(n, Mz)  # rows: nodes over the sea span, the fine rows' overhang two cells
     # (the factor has a kink at the horizon, ζ = 0, where the overhang below it holds θ̂ = 90°)
     xg_t = torch.as_tensor(xg, dtype=torch.float64, device=device)
-    u_a, u_b = u_ab
-    ang = _angle_of_ratio(u_a[:, None] + (u_b - u_a)[:, None] * (y_cols + 1) / 2, False)
+    ang = col_angle(y_cols)
     a0, a1 = ang[:, 0], ang[:, -1]  # columns: nodes over every column, overhang included (it has no kink,
     # and a polynomial of this degree must not be extrapolated by the columns' coarser cells)
     th_n, ph_n = angles(lo[:, None] + span_z[:, None] * (xg_t + 1) / 2, a0[:, None] + (a1 - a0)[:, None] * (xg_t + 1) / 2)
@@ -1364,8 +1369,7 @@ def _glint_core_table(scene: SeaScene, p: dict[str, Any], sl: slice, eps: torch.
         i = torch.linspace(_EXT, Mz - 2 - _EXT, 48, device=device).round().long().unique()  # rows pixels read
         j = torch.arange(0, y_cols.shape[0] - 1, 2, device=device)
         th, ph = angles(lo[:, None] + span_z[:, None] * (0.5 * (y_z[i] + y_z[i + 1]) + 1) / 2,
-                        _angle_of_ratio(u_a[:, None] + (u_b - u_a)[:, None] * (0.5 * (y_cols[j + 1] + y_cols[j]) + 1) / 2,
-                                        False))
+                        col_angle(0.5 * (y_cols[j + 1] + y_cols[j])))
         r_c, s_c = smooth(th, ph), sharp(th, ph)
         if scale_rows is not None:
             r_c = r_c * (0.5 * (scale_rows[:, i] + scale_rows[:, i + 1]))[:, :, None]
@@ -1508,6 +1512,10 @@ def _render_table(
     # (views along the wind at W = 0 were off by 8e-4 with 9 nodes; pipelines/accuracy_pareto.py).
     day = _day(scene, B, dtype, device)  # a day sky is not symmetric about the wind: no folding
     fold = not iso and day is None and bool((p["cxy"] == 0).all())
+    # nor under a half turn (R_a(φ̂ + π) ≠ R_a(φ̂)): its unfolded coordinate runs over 2π (it ran over π,
+    # and a view with every azimuth, looking down at the nadir, read the sky half a turn away: up to
+    # 0.24 K off per-pixel evaluation in MWIR)
+    period = 2 * math.pi if day is not None else math.pi
     # ε: a quarter of the smallest rms slope of each image, so ζ resolves the grazing layer.
     lam_min = 0.5 * (p["vx"] + p["vy"] - torch.sqrt((p["vx"] - p["vy"]) ** 2 + 4 * p["cxy"] ** 2))
     eps = (0.25 * torch.sqrt(lam_min.detach().clamp_min(0.0))).clamp(1e-4, 0.05).double()
@@ -1535,7 +1543,7 @@ def _render_table(
         _check_path_altitude(scene.path, altitude)
     # the table's azimuth coordinate: from cameras, without texture (whose own table reads the angle),
     # the cheap u of _azimuth_ratio, the fine columns uniform in u; else the angle
-    ratio = not (iso or textured) and geometry is None
+    ratio = not (iso or textured) and geometry is None and day is None
     if sunny and cg is None:
         raise ValueError("geometry=: a scene with a sun needs the cameras (its glint and disk are per pixel, the "
                          "disk sized by the pixel's field of view); call render(cameras, scene) without geometry=")
@@ -1556,7 +1564,7 @@ def _render_table(
         b_ = sl.stop - sl.start
         wd = p["wind_direction"][sl]
         rg = (_geometry_ranges(geometry, sl, wd, inv_eps[sl], iso, fold) if geometry is not None
-              else _camera_ranges(cg, sl, wd, inv_eps[sl], iso, fold))
+              else _camera_ranges(cg, sl, wd, inv_eps[sl], iso, fold, period))
 
         # ---- node spans (float64) -----------------------------------------------------------------
         lo, hi = (torch.where(rg.any_sea, v, torch.full_like(v, d)) for v, d in zip(rg.zeta, (0.0, 1.0)))
@@ -1571,13 +1579,13 @@ def _render_table(
         else:
             a, b = (torch.where(rg.any_sea, v, torch.full_like(v, d)) for v, d in zip(rg.azimuth, (0.0, 1.0)))
             if table.span == "full":
-                a, b = torch.zeros_like(a), torch.full_like(b, math.pi / 2 if fold else math.pi)
+                a, b = torch.zeros_like(a), torch.full_like(b, math.pi / 2 if fold else period)
             pad = torch.clamp(1e-6 * (b - a), min=1e-6)
             a, b = a - pad, b + pad
             if fold:  # ψ ∈ [0, π/2]: keep the nodes inside it (the kink stays at the interval's end)
                 a, b = a.clamp_min(0.0), b.clamp_max(math.pi / 2)
-            # the pixels' o = wrap_π(φ̂ − c) + π/2: nodes at φ̂ = c + o − π/2 (folded: φ̂ = o = ψ)
-            shift = 0.0 if fold else math.pi / 2
+            # the pixels' o = wrap_P(φ̂ − c) + P/2: nodes at φ̂ = c + o − P/2 (folded: φ̂ = o = ψ)
+            shift = 0.0 if fold else period / 2
 
             def az_nodes(x: torch.Tensor) -> torch.Tensor:  # Lobatto nodes x ∈ [−1, 1] → φ̂ over [a, b]
                 return (rg.centre[:, None] - shift + a[:, None] + (b - a)[:, None] * (x + 1) / 2).to(dtype)
@@ -1683,21 +1691,28 @@ def _render_table(
             fine = torch.cat([sea_rows, sky_rows[:, :, None]], 1)  # (b, N, 1)
         else:  # sea rows resampled in azimuth; sky rows repeated (not through L_o, whose overhang
             # rows sum to 1 only to rounding: sky pixels may read the border columns)
+            y = torch.linspace(-1.0 - ep, 1.0 + ep, Lp_t.shape[0], dtype=torch.float64, device=device)
             if ratio:  # columns uniform in u (_azimuth_ratio): the node coordinate of each, per image
                 u_a, u_b = _ratio_of_angle(a, fold), _ratio_of_angle(b, fold)
-                y = torch.linspace(-1.0 - ep, 1.0 + ep, Lp_t.shape[0], dtype=torch.float64, device=device)
-                ang = _angle_of_ratio(u_a[:, None] + (u_b - u_a)[:, None] * (y + 1) / 2, fold)
-                L_cols = _barycentric(xp, 2.0 * (ang - a[:, None]) / (b - a)[:, None] - 1.0).to(dtype)
+
+                def col_angle(t: torch.Tensor) -> torch.Tensor:  # the angle o of column coordinates t ∈ [−1, 1]
+                    return _angle_of_ratio(u_a[:, None] + (u_b - u_a)[:, None] * (t + 1) / 2, fold)
+
+                L_cols = _barycentric(xp, 2.0 * (col_angle(y) - a[:, None]) / (b - a)[:, None] - 1.0).to(dtype)
                 sea_cols = sea_rows @ L_cols.transpose(1, 2)
-                if sunny and not (fold or textured):  # the glint's smooth factor, where the table resolves it
-                    scale = None if scene.path is None else tau.to(dtype)
-                    if p["foam"] is not None:
-                        f = 1.0 - p["foam"][sl].to(dtype)[:, None]
-                        scale = f.expand(b_, Mz) if scale is None else scale * f
-                    r_glint, glint_tab = _glint_core_table(scene, p, sl, eps[sl], lo, span_z, y_z, (u_a, u_b), y,
-                                                           rg.centre, sea_cols, scale, table, dtype)
-            else:
+            else:  # columns uniform in the angle o
+
+                def col_angle(t: torch.Tensor) -> torch.Tensor:
+                    return a[:, None] + (b - a)[:, None] * (t + 1) / 2
+
                 sea_cols = sea_rows @ Lp_t.T
+            if sunny and not (fold or textured):  # the glint's smooth factor, where the table resolves it
+                scale = None if scene.path is None else tau.to(dtype)
+                if p["foam"] is not None:
+                    f = 1.0 - p["foam"][sl].to(dtype)[:, None]
+                    scale = f.expand(b_, Mz) if scale is None else scale * f
+                r_glint, glint_tab = _glint_core_table(scene, p, sl, eps[sl], lo, span_z, y_z, col_angle, y,
+                                                       rg.centre, period / 2, sea_cols, scale, table, dtype)
             fine = torch.cat([sea_cols, sky_rows[:, :, None].expand(-1, -1, Lp_t.shape[0])], 1)
         if crest:  # channel 1: the foam (sky rows alike), one grid_sample reads both
             fine = torch.stack([fine, torch.cat([foam_rows, sky_rows], 1)[:, :, None].expand_as(fine)], 1)
@@ -1714,7 +1729,8 @@ def _render_table(
         k_sea, b_sea, k_sky, b_sky = (v.to(dtype)[:, None, None] for v in (k_sea, b_sea, k_sky, b_sky))
         # the azimuth coordinate's offset: o = (ray azimuth + offset) mod π (folded: ψ = |o − π/2|)
         offset = None if iso else ((math.pi / 2 - wd).to(dtype) if fold else
-                                   (math.pi / 2 - rg.centre - wd.double()).to(dtype))
+                                   (math.pi / 2 - rg.centre - wd.double()).to(dtype) if period == math.pi else
+                                   (-rg.centre - wd.double()).to(dtype))
         if not iso:  # gx = b_az + k_az · (the azimuth coordinate: its ratio stand-in u, or the angle)
             lo_a, hi_a = (u_a, u_b) if ratio else (a, b)
             k_az = (2.0 / ((hi_a - lo_a) * (1.0 + ep))).to(dtype)[:, None, None]
@@ -1765,7 +1781,7 @@ def _render_table(
         if iso:
             gx = torch.zeros_like(gy)
         else:
-            az = _azimuth_ratio(c_t, s_t, fold) if ratio else _azimuth_coordinate(dx, dy, offset, fold)
+            az = _azimuth_ratio(c_t, s_t, fold) if ratio else _azimuth_coordinate(dx, dy, offset, fold, period)
             gx = torch.addcmul(b_az, az, k_az)
         # bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges
         # only to first order; bilinear on the fine table is second order (~3e-7 at 3072 rows).
