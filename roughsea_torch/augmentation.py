@@ -466,7 +466,9 @@ def _render_frames(
             seed=[int(s) for s in params["wave_seed"][idx.to(params["wave_seed"].device)].tolist()] if tex else None,
             foam=foam, **sun,
         ), device)
-        pose = {name: f(name, frames) for name in ("pitch_deg", "roll_deg", "altitude_m", "time_s")}
+        pose = {name: f(name, frames) for name in ("pitch_deg", "roll_deg", "altitude_m")}
+        # the wave time stays float64 (TextureTable's phases ω t): float32 rounds 1e5 s to 1/128 s
+        pose["time_s"] = frames["time_s"][idx.to(frames["time_s"].device)].to(dtype=torch.float64, device=device)
         cam = dict(hfov_deg=f("hfov_deg"), yaw_deg=f("yaw_deg"))
         for t in range(T):
             frame_scene = scene

@@ -155,6 +155,7 @@ def render_clip(
     for t in it:
         cams = cameras.cameras(t) if isinstance(cameras, PlatformMotion) else cameras(t) if callable(cameras) else cameras
         frame_scene = copy.copy(scene)  # shares the sky tables and the wave-field cache
-        frame_scene.time_s = base + t
+        # in float64 (a float32 start of 1e6 s would round 25 Hz frames onto each other)
+        frame_scene.time_s = base.to(torch.float64) + t if isinstance(base, torch.Tensor) else base + t
         frames.append(render(cams, frame_scene, **render_kwargs))
     return torch.stack(frames, 1)
