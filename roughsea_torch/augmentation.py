@@ -530,7 +530,7 @@ def render_parameters(
     frames["time_s"] = (params["time_s"].detach().cpu().to(torch.float64) if "time_s" in params
                         else torch.zeros(B, dtype=torch.float64))[:, None]
     return _render_frames(params, frames, height, width, atmospheres, band, anisotropic, dtype, device, table,
-                          quadrature, earth_radius_m, path, check_foam(foam))[:, 0]
+                          quadrature, earth_radius_m, path, check_foam(foam, per_image=False))[:, 0]
 
 
 def render_clip_parameters(
@@ -558,7 +558,7 @@ def render_clip_parameters(
     there."""
     frames = frame_parameters(params, num_frames, frame_rate)
     return _render_frames(params, frames, height, width, atmospheres, band, anisotropic, dtype, device, table,
-                          quadrature, earth_radius_m, path, check_foam(foam))
+                          quadrature, earth_radius_m, path, check_foam(foam, per_image=False))
 
 
 def _worker_stream(generator: torch.Generator, worker_id: int) -> torch.Generator:
@@ -631,8 +631,17 @@ def _check_params(params: Any, B: int, atmospheres: Sequence[str], gate_sizes: t
     if atm.numel() and not bool(((atm >= 0) & (atm < len(atmospheres))).all()):
         raise ValueError(f"params['atmosphere']: indices must lie in [0, {len(atmospheres) - 1}] (into atmospheres="
                          f"{list(atmospheres)}); got {atm.tolist()}")
-    if "wave_seed" in params and bool((params["wave_seed"] < 0).any()):
-        raise ValueError(f"params['wave_seed']: seeds must lie in [0, 2**63); got {params['wave_seed'].tolist()}")
+    for k in ("noise_seed", "wave_seed"):
+        if k in params and bool((params[k] < 0).any()):
+            raise ValueError(f"params[{k!r}]: seeds must lie in [0, 2**63); got {params[k].tolist()}")
+    if "is_day" in params:  # a day draw: the sun of each day image
+        missing = [k for k in ("sun_elevation_deg", "sun_azimuth_deg") if k not in params]
+        if missing:
+            raise ValueError(f"params: a draw with 'is_day' needs {missing} too (the sun of its day images)")
+    motion = [k for k in (*_MOTION_NAMES, "phase_rad") if k in params]
+    if motion and len(motion) < len(_MOTION_NAMES) + 1:  # all of the platform's motion, or none (a still pose)
+        missing = [k for k in (*_MOTION_NAMES, "phase_rad") if k not in params]
+        raise ValueError(f"params: a draw with platform motion needs all of its fields; missing {missing}")
     if "time_s" in params:
         check_time("params['time_s']", params["time_s"])
 
@@ -832,7 +841,7 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
         self.table = table
         self.quadrature = quadrature
         self.path = path
-        self.foam = check_foam(foam)
+        self.foam = check_foam(foam, per_image=False)
         self.generator = generator
         self._call_generator: torch.Generator | None = None
         self._worker: tuple[tuple[int, int], torch.Generator] | None = None
@@ -1020,7 +1029,7 @@ class RandomSeaClip(_Seas, torch.nn.Module):
         self.table = table
         self.quadrature = quadrature
         self.path = path
-        self.foam = check_foam(foam)
+        self.foam = check_foam(foam, per_image=False)
         self.generator = generator
         self.p = float(p)
         self.same_on_batch = same_on_batch

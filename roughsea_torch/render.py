@@ -30,6 +30,7 @@ import os
 import threading
 from dataclasses import dataclass
 from functools import lru_cache
+from numbers import Integral, Real
 from typing import Any, Callable
 
 import numpy as np
@@ -76,16 +77,23 @@ def _chunk_images(scene: Any, chunk: Any = None) -> Any:
 _CACHE_LOCK = threading.RLock()  # SeaScene's caches (skies, wave fields), filled from worker threads
 
 
-def check_foam(foam: Any) -> Any:
+def check_foam(foam: Any, per_image: bool = True) -> Any:
     """``SeaScene``'s ``foam`` argument, normalized (``None`` for none), or a ``ValueError``: ``"auto"``,
-    ``False``/``None``, or a whitecap fraction in [0, 1] (float or (B,))."""
+    ``False``/``None``, or a whitecap fraction in [0, 1] (a float, or (B,) with ``per_image``). ``True``
+    is refused: it read as a fraction of 1 (a sea all foam), where "on" means ``"auto"``."""
     if foam is None or foam is False:
         return None
+    if foam is True or (isinstance(foam, (torch.Tensor, np.ndarray)) and foam.dtype in (torch.bool, np.bool_)):
+        raise ValueError("foam must be 'auto' (whitecaps from the wind), False or a fraction in [0, 1]; got True "
+                         "(a bool: use 'auto' for whitecaps, 1.0 for a sea all foam)")
     if isinstance(foam, str):
         if foam != "auto":
             raise ValueError(f"foam must be 'auto', False or a fraction in [0, 1]; got {foam!r}")
         return foam
     check_finite_range("foam", foam, 0.0, 1.0)
+    if not per_image and isinstance(foam, (torch.Tensor, np.ndarray)) and foam.ndim > 0:
+        raise ValueError(f"foam: one setting for every image ('auto', False or a float in [0, 1]); got shape "
+                         f"{tuple(foam.shape)} (per-image fractions belong in a SeaScene)")
     return foam
 
 
@@ -637,12 +645,15 @@ class TableSize:
         for name in ("texture_quadrature", "texture_quadrature_steep"):
             rule = getattr(self, name)
             if (not isinstance(rule, (tuple, list)) or len(rule) != 2
-                    or not all(isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= 512 for v in rule)):
+                    or not all(isinstance(v, Integral) and not isinstance(v, (bool, np.bool_)) and 1 <= v <= 512
+                               for v in rule)):
                 raise ValueError(f"TableSize.{name} must be (outer, inner), two ints in [1, 512]; got {rule!r}")
+            object.__setattr__(self, name, tuple(int(v) for v in rule))  # hashable (tables are cached by it)
         for name, lo, hi in (("texture_steep_zenith_deg", 0.0, 90.0), ("texture_quadrature_width", 1.0, 40.0)):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo <= float(v) <= hi:
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real) or not lo <= float(v) <= hi:
                 raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")
+            object.__setattr__(self, name, float(v))
         share = self.texture_min_band_share
         if isinstance(share, bool) or not isinstance(share, (int, float)) or not 0.0 <= float(share) < 1.0:
             raise ValueError(f"TableSize.texture_min_band_share must be a number in [0, 1); got {share!r}")

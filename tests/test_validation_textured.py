@@ -132,6 +132,9 @@ def _background_and_draw():
         (lambda p: p.update(time_s=torch.tensor([float("nan"), 3.0], dtype=torch.float64)), r"params\['time_s'\] must lie in " + TIME_RANGE),
         (lambda p: p.update(atmosphere=torch.tensor([0, 4])), r"params\['atmosphere'\]: indices must lie in \[0, 0\]"),
         (lambda p: p.pop("wind_speed"), r"params: missing \['wind_speed'\]"),
+        (lambda p: p.update(noise_seed=torch.tensor([-1, 3])), r"params\['noise_seed'\]: seeds must lie in"),
+        (lambda p: p.update(is_day=torch.tensor([True, False])), r"'is_day' needs \['sun_elevation_deg', 'sun_azimuth_deg'\]"),
+        (lambda p: p.update(pitch_amplitude_deg=torch.ones(2, dtype=torch.float64)), r"platform motion needs all"),
     ],
 )
 def test_replayed_background_params_are_checked(change, message):
@@ -205,3 +208,29 @@ def test_platform_motion_checks_its_poses_when_built(kw, name):
     ok = rs.PlatformMotion(pitch_deg=-88.0, pitch_amplitude_deg=2.0, roll_deg=178.0, roll_amplitude_deg=2.0)
     for t in (1.5, 4.5, 0.0, 2.25):  # the extremes of pitch (period 6 s) and roll (9 s, phase π/2)
         ok.cameras(t)
+
+
+def test_texture_rules_accept_lists_and_numpy_numbers():
+    """TableSize's texture rules: a list [20, 16] is kept as the tuple (it passed the check, then the
+    render raised TypeError: unhashable type: 'list'); numpy integers and floats are numbers; a rule
+    of a zero or a float is a ValueError naming it (found in review)."""
+    t = rs.TableSize(texture_quadrature=[20, 16], texture_quadrature_steep=(np.int64(16), 16),
+                     texture_quadrature_width=np.float32(4.5))
+    assert t.texture_quadrature == (20, 16) and t.texture_quadrature_steep == (16, 16)
+    assert torch.isfinite(rs.render(cams(), scene(seed=1), table=t)).all()
+    for bad in (dict(texture_quadrature=(0, 16)), dict(texture_quadrature=(2.5, 16)), dict(texture_quadrature_width=0.5)):
+        with pytest.raises(ValueError, match=f"TableSize.{next(iter(bad))}"):
+            rs.TableSize(**bad)
+
+
+def test_foam_true_is_refused_and_augmentations_take_one_setting():
+    """foam=True read as a whitecap fraction of 1 (a sea all foam) where a user means "on": it is a
+    ValueError that points at 'auto'. An augmentation takes one foam setting for every image (a
+    per-image tensor failed whenever the gate picked a subset; found in review)."""
+    for make in (lambda f: rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, foam=f),
+                 lambda f: rs.RandomSeaBackground(foam=f), lambda f: rs.RandomSeaClip(foam=f)):
+        with pytest.raises(ValueError, match="'auto'"):
+            make(True)
+    with pytest.raises(ValueError, match="foam: one setting for every image"):
+        rs.RandomSeaBackground(foam=torch.tensor([0.0, 1.0]))
+    assert rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, foam=torch.tensor([0.0, 1.0])).foam is not None
