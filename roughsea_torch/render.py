@@ -575,8 +575,8 @@ class TableSize:
             sun and the departure is sharp in slope and azimuth: an MWIR sea then sits 7e-4 of
             the radiance from a converged per-pixel render; ``texture_quadrature=(20, 16)``,
             ``texture_azimuth_sun=17`` and ``fine_texture_azimuth=64`` together bring it to
-            2.4e-4 (the first alone 4.5e-4, the other two 6.9e-4) at 1.75× the time of a textured
-            day render (``tests/test_sun.py``).
+            2.4e-4 (the first alone 4.5e-4, the other two 6.9e-4) at 1.7× the time of a textured
+            day render (``tests/test_sun.py``, ``docs/bench_texture.md``).
         texture_quadrature_steep, texture_steep_zenith_deg: the rule of the texture nodes whose view
             zenith θ̂ is below ``texture_steep_zenith_deg`` [deg]. Looking steeply down, the texture is
             a few mK while the shifted Gaussians are narrow and reach the edge of the
@@ -587,8 +587,10 @@ class TableSize:
             (float64) is too wide for a 12-node rule: Gauss–Legendre on ±7.5σ misses 1 % of a
             Gaussian's mass, on ±4.5σ 1e-5 (the window drops 7e-6); looking straight down at 8 m/s
             the texture was then 0.11 K off per-pixel evaluation (float64; 0.015 K in float32, whose
-            window is 6σ) against 2e-4 K now. Grazing views, where the texture is tens of mK, move
-            by 2e-4 K at most (``pipelines/texture_accuracy.py``).
+            window is 6σ) against 2e-4 K now. Grazing views, where the texture is tens of mK: their
+            error against per-pixel evaluation changed by 2e-4 K at most (the sweep of
+            ``pipelines/texture_accuracy.py`` before and after), the images themselves by up to
+            4e-3 K (20 m, pitch −20°, 3 m/s).
         texture_min_band_share: per image, the octaves of the wave field that carry less than this
             share of its slope variance (and of its crest variable's) are left out of the
             realization, their variance left to the unresolved statistics (``WaveField(...,

@@ -266,8 +266,8 @@ def test_textured_day_with_the_lowtran_day_sky_matches_per_pixel_and_keeps_the_s
     (against a converged per-pixel render, 80×80 quadrature, 7.0e-4): the nodes' rule
     (TableSize.texture_quadrature (20, 16) alone: 4.5e-4) and their azimuths (17 with
     fine_texture_azimuth=64 alone: 6.9e-4); both give 2.4e-4 (asserted below 4e-4; the azimuths
-    alone, planted, fail) at 1.75x the time of a textured day render (bench batch, 3.9 s → 6.7
-    s); the default keeps the cheaper nodes. With an explicit rs.Sun (no day sky) the default
+    alone, planted, fail) at 1.7x the time of a textured day render (docs/bench_texture.md); the
+    default keeps the cheaper nodes. With an explicit rs.Sun (no day sky) the default
     gives 8e-5, with the sun behind the cameras 1.8e-5, in LWIR 2e-5."""
     cams = rs.make_camera(24, 32, hfov_deg=40.0, altitude_m=15.0, pitch_deg=-5.0,
                           yaw_deg=torch.tensor([0.0, 30.0], dtype=torch.float64), batch_size=2, dtype=torch.float64)
