@@ -30,6 +30,7 @@ from pathlib import Path
 import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _report import pyplot, write_report  # noqa: E402
 from bench_render import B, H, W, batch, med, peak_memory  # noqa: E402
 
 import roughsea_torch as rs  # noqa: E402
@@ -209,17 +210,9 @@ def main() -> None:
               f"{reads['read_time'] / (reads['reads_per_pixel'] * B * H * W) * 1e9:.2f} | "
               f"{reads['read_time'] / t_mean1:.2f} |"]
     print("\n".join(lines[-5:]), file=sys.stderr)
-    report = "\n".join(lines) + "\n"
-    print(report)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "bench_texture.md").write_text(report)
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
+    out = write_report(args.out, "bench_texture.md", "\n".join(lines) + "\n")
+    plt = pyplot()
+    if plt is not None:
         fig, ax = plt.subplots(figsize=(5, 3.2))
         x = range(len(rows))
         ax.bar([i - 0.2 for i in x], [r[1] for r in rows], 0.4, label="expectation")
@@ -229,8 +222,6 @@ def main() -> None:
         ax.legend()
         fig.tight_layout()
         fig.savefig(out / "bench_texture.png", dpi=120)
-    except ImportError:
-        pass
 
 
 if __name__ == "__main__":

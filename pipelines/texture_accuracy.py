@@ -22,7 +22,10 @@ from pathlib import Path
 
 import torch
 
-import roughsea_torch as rs
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _report import pyplot, write_report  # noqa: E402
+
+import roughsea_torch as rs  # noqa: E402
 
 PITCHES = (-90.0, -70.0, -45.0, -20.0, -8.0, -3.0, -1.0)
 ALTITUDES = (20.0, 300.0)
@@ -70,17 +73,9 @@ def main() -> None:
              "| dtype | altitude [m] | pitch [deg] | wind [m/s] | max abs(table − direct) [K] | texture std [K] |",
              "|---|---:|---:|---:|---:|---:|"]
     lines += [f"| {d} | {a:.0f} | {p:.0f} | {w:.0f} | {e:.4f} | {s:.4f} |" for d, a, p, w, e, s in rows]
-    report = "\n".join(lines) + "\n"
-    print(report)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "texture_accuracy.md").write_text(report)
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
+    out = write_report(args.out, "texture_accuracy.md", "\n".join(lines) + "\n")
+    plt = pyplot()
+    if plt is None:
         return
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8), sharey=True)
     for ax, alt in zip(axes, ALTITUDES):
