@@ -56,7 +56,7 @@ def plot_one(atmosphere: str, band_name: str, band: tuple[float, float], out: Pa
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", type=Path, default=Path("outputs/examples"))
+    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "examples")
     ap.add_argument("--atmospheres", nargs="+", default=None, help="default: every shipped atmosphere")
     ap.add_argument("--bands", nargs="+", default=["LWIR", "MWIR"], choices=["LWIR", "MWIR"])
     args = ap.parse_args()

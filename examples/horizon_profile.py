@@ -26,7 +26,7 @@ from _common import plt
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", type=Path, default=Path("outputs/examples"))
+    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "examples")
     args = ap.parse_args()
     alts = [5.0, 20.0, 100.0, 1000.0, 5000.0]
     H, W, vfov = 1024, 8, 4.0  # 0.004° a row

@@ -154,7 +154,8 @@ def plot_path_atmospheres(band_key: str, out: Path, h: float = 20.0) -> Path:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", type=Path, default=Path("outputs/atmospheres"), help="folder for the PNGs")
+    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "atmospheres",
+                    help="folder for the PNGs")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     written = [plot_sky(b, args.out) for b in BANDS] + [plot_fig2(args.out)]

@@ -13,8 +13,8 @@ statistics). Writes to ``--out``:
 Usage:
     python examples/render_default.py [--out outputs/default] [--batch 8] [--height 512] [--width 640]
 
-(from the repository's root; the README's quick start runs it from ``examples/`` with
-``--out ../outputs/default``, the same place)
+(the default ``--out`` is the repository's ``outputs/default``, from whatever directory it runs;
+the README's quick start runs it from ``examples/`` with ``--out ../outputs/default``, the same place)
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ def default_batch(batch: int, seed: int = 0) -> dict[str, torch.Tensor]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", type=Path, default=Path("outputs/default"))
+    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "default")
     ap.add_argument("--batch", type=int, default=8)
     ap.add_argument("--height", type=int, default=512)
     ap.add_argument("--width", type=int, default=640)

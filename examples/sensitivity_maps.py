@@ -22,7 +22,7 @@ from _common import save_grid
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", type=Path, default=Path("outputs/examples"))
+    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "examples")
     ap.add_argument("--sky", default="midlatitude_summer")
     args = ap.parse_args()
     wind = torch.tensor(8.0, requires_grad=True)

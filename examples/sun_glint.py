@@ -11,7 +11,7 @@ Writes to ``--out``:
   sun 20° above the horizon, MWIR, for winds of 2, 5, 10 and 15 m/s (``rs.glint_radiance``).
 
 Usage:
-    python examples/sun_glint.py [--out ../outputs/examples]
+    python examples/sun_glint.py [--out outputs/examples]  (default: the repository's, from any directory)
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from _common import plt, save_grid
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", type=Path, default=Path("../outputs/examples"))
+    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "examples")
     ap.add_argument("--height", type=int, default=256)
     ap.add_argument("--width", type=int, default=320)
     ap.add_argument("--mwir-irradiance", type=float, default=12.0)

@@ -13,7 +13,7 @@ Writes to ``--out``:
 - ``textured_clip_frames.png``: four of its frames.
 
 Usage:
-    python examples/textured_sea.py [--out ../outputs/examples] [--height 256] [--width 320]
+    python examples/textured_sea.py [--out outputs/examples] [--height 256] [--width 320]  (default: the repository's)
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from _common import save_grid
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", type=Path, default=Path("../outputs/examples"))
+    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "examples")
     ap.add_argument("--height", type=int, default=256)
     ap.add_argument("--width", type=int, default=320)
     ap.add_argument("--frames", type=int, default=40)

@@ -172,7 +172,7 @@ def main() -> None:
     ap.add_argument("--height", type=int, default=128)
     ap.add_argument("--width", type=int, default=160)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--out", type=Path, default=Path("outputs/train"))
+    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "train")
     a = ap.parse_args()
     r = train(a.steps, a.batch, a.height, a.width, a.seed)
     counts, mask, params = r["batch0"]

@@ -21,7 +21,7 @@ from _common import save_grid
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--out", type=Path, default=Path("outputs/examples"))
+    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "examples")
     ap.add_argument("--sky", default="midlatitude_summer")
     args = ap.parse_args()
     winds = torch.tensor([0.0, 2.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0])

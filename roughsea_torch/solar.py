@@ -292,7 +292,7 @@ def sun_position(time: Any, latitude_deg: float, longitude_deg: float, *, altitu
         import pvlib
     except ImportError as err:  # pragma: no cover - depends on the environment
         raise ImportError(
-            "sun_position needs pvlib (which brings pandas), an optional dependency: pip install pvlib"
+            "sun_position needs pvlib (which brings pandas), an optional dependency: pip install -e '.[sun]' (from the repository) or pip install pvlib"
         ) from err
     scalar = not isinstance(time, (list, tuple, np.ndarray, pd.DatetimeIndex))
     idx = pd.DatetimeIndex(pd.to_datetime([time] if scalar else list(time)))
