@@ -528,7 +528,10 @@ class TableSize:
             (``SeaScene(aerosol=)``): it has the aerosol's forward-scattering peak about the sun and is
             tabulated piecewise linearly in azimuth (:mod:`roughsea_torch.daysky`), so Chebyshev
             nodes converge slowly: MWIR, sun 20° up ahead, 20 m mast at 2° down, against per-pixel
-            evaluation: 7 nodes 1.9e-3, 13 2.3e-4, 25 3.7e-5.
+            evaluation: 7 nodes 1.9e-3, 13 2.3e-4, 25 3.7e-5. A render with every azimuth in view
+            (looking down at the nadir) takes 2·azimuth_day − 1 nodes and twice ``fine_azimuth``
+            columns, and its texture 4·(texture_azimuth_sun − 1) + 1 nodes and eight times
+            ``fine_texture_azimuth`` (``tests/test_sun.py``).
         zenith_narrow: nodes in ζ when some image's slope ellipse is narrow but not thin (minor/major
             rms slope < 0.5: Cox–Munk below ~0.3 m/s): views along the wind at W = 0.05 m/s,
             2.9e-5 with 17 nodes, 1.4e-5 with 21.
