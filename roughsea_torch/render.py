@@ -529,9 +529,9 @@ class TableSize:
             tabulated piecewise linearly in azimuth (:mod:`roughsea_torch.daysky`), so Chebyshev
             nodes converge slowly: MWIR, sun 20° up ahead, 20 m mast at 2° down, against per-pixel
             evaluation: 7 nodes 1.9e-3, 13 2.3e-4, 25 3.7e-5. A render with every azimuth in view
-            (looking down at the nadir) takes 2·azimuth_day − 1 nodes and twice ``fine_azimuth``
-            columns, and its texture 4·(texture_azimuth_sun − 1) + 1 nodes and eight times
-            ``fine_texture_azimuth`` (``tests/test_sun.py``).
+            (looking down at the nadir), or with ``span="full"``, takes 2·azimuth_day − 1 nodes and
+            twice ``fine_azimuth`` columns, and its texture 4·(texture_azimuth_sun − 1) + 1 nodes and
+            four times ``fine_texture_azimuth`` (``tests/test_sun.py``).
         zenith_narrow: nodes in ζ when some image's slope ellipse is narrow but not thin (minor/major
             rms slope < 0.5: Cox–Munk below ~0.3 m/s): views along the wind at W = 0.05 m/s,
             2.9e-5 with 17 nodes, 1.4e-5 with 21.
@@ -1335,7 +1335,8 @@ def _glint_core_table(scene: SeaScene, p: dict[str, Any], sl: slice, eps: torch.
 
     The factor is evaluated at ``table.glint``² Chebyshev–Lobatto nodes (in ζ over the sea rows' span,
     in azimuth over every column) and resampled spectrally. An image is served when its pixels span
-    less than π in azimuth (without a day sky the coordinate has period π, the glint has not) and, at the centres of the fine cells
+    less than π in azimuth (a coordinate of period π would fold the glint, which has none; under a day
+    sky the period is 2π, and the table keeps to spans below π all the same) and, at the centres of the fine cells
     of 48 rows and every other column (where bilinear reading errs most), the table's glint is within
     ``table.glint_tolerance`` of direct evaluation, relative to the radiance there (``sea_cols``, the
     sea's fine table, plus the glint).
@@ -1536,18 +1537,23 @@ def _render_table(
     lam_min = 0.5 * (p["vx"] + p["vy"] - torch.sqrt((p["vx"] - p["vy"]) ** 2 + 4 * p["cxy"] ** 2))
     eps = (0.25 * torch.sqrt(lam_min.detach().clamp_min(0.0))).clamp(1e-4, 0.05).double()
     inv_eps = (1.0 / eps).to(dtype)
-    if day is not None and cg is not None and table.span != "full":
-        # an image with every azimuth in view (looking down at the nadir) spreads the day sky's azimuth
-        # structure (the aureole about the sun) over the whole turn: twice the mean's azimuth nodes and
-        # columns, four times the texture's nodes and eight times its columns, for the whole render (MWIR,
-        # 20 m, 8 m/s, sun 34° from the zenith, four sun and wind azimuths: 0.025 → 0.0076 K, textured
-        # 0.056 → 0.016 K against per-pixel evaluation)
-        rg_all = _camera_ranges(cg, slice(0, B), p["wind_direction"], inv_eps, False, False, 2 * math.pi)
-        turn = (rg_all.azimuth[1] - rg_all.azimuth[0]) > math.pi
-        if bool((turn & rg_all.any_sea).any()):
-            table = replace(table, azimuth_day=2 * table.azimuth_day - 1, fine_azimuth=2 * table.fine_azimuth,
+    if day is not None and cg is not None:
+        # an image with every azimuth in view (looking down at the nadir; every image with span="full")
+        # spreads the day sky's azimuth structure (the aureole about the sun) over the whole turn: twice the
+        # mean's azimuth nodes and columns, four times the texture's nodes and columns, for the whole render
+        # (so an image's pixels then depend on whether such an image shares its batch, by up to ~1e-3 K).
+        # MWIR, 20 m, 8 m/s, nadir views: over four sun and wind azimuths 0.025 -> 0.0076 K, textured
+        # 0.056 -> 0.016 K against per-pixel evaluation; over a wider sweep (sun zenith to 1 rad, 90° field
+        # of view) up to 2.2e-2 and 3.5e-2 K remain, which more nodes reduce (TableSize.azimuth_day,
+        # texture_azimuth_sun; four times these: 8.7e-3 and 6.5e-3 K at 2.4x the time)
+        turn = table.span == "full"
+        if not turn:
+            rg_all = _camera_ranges(cg, slice(0, B), p["wind_direction"], inv_eps, False, False, 2 * math.pi)
+            turn = bool((((rg_all.azimuth[1] - rg_all.azimuth[0]) > math.pi) & rg_all.any_sea).any())
+        if turn:
+            table = replace(table, azimuth_day=2 * (table.azimuth_day - 1) + 1, fine_azimuth=2 * table.fine_azimuth,
                             texture_azimuth_sun=4 * (table.texture_azimuth_sun - 1) + 1,
-                            fine_texture_azimuth=8 * table.fine_texture_azimuth)
+                            fine_texture_azimuth=4 * table.fine_texture_azimuth)
     lam_max = 0.5 * (p["vx"] + p["vy"] + torch.sqrt((p["vx"] - p["vy"]) ** 2 + 4 * p["cxy"] ** 2))
     thin = bool((lam_min.detach() < 0.04 * lam_max.detach()).any())  # minor/major rms slope < 0.2
     narrow = bool((lam_min.detach() < 0.25 * lam_max.detach()).any())  # minor/major rms slope < 0.5
