@@ -386,8 +386,8 @@ class TextureTable:
         elif bool(steep.all()):
             t_s, t_rho = terms(slice(None), *self.quadrature_steep)
         else:
-            parts = [(m.nonzero().flatten(), terms(m.nonzero().flatten(), *rule))
-                     for m, rule in ((~steep, self.quadrature), (steep, self.quadrature_steep))]
+            groups = [(m.nonzero().flatten(), rule) for m, rule in ((~steep, self.quadrature), (steep, self.quadrature_steep))]
+            parts = [(sel, terms(sel, *rule)) for sel, rule in groups]
             t_s, t_rho = (torch.zeros(ct.shape[0], cols[1] + 1, dtype=parts[0][1][0].dtype, device=device)
                           .index_put((parts[0][0],), parts[0][1][i]).index_put((parts[1][0],), parts[1][1][i])
                           for i in (0, 1))

@@ -187,10 +187,8 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
     for key in ("anisotropic", "path", "texture", "sun_azimuth_relative_to_yaw"):
         if not isinstance(sc[key], bool):
             raise ValueError(f"config: scene.{key} must be true or false; got {sc[key]!r}")
-    if sc["foam"] is not True and not (sc["foam"] in ("auto", False) or isinstance(sc["foam"], (int, float))):
-        raise ValueError(f"config: scene.foam must be \"auto\", false or a whitecap fraction in [0, 1]; got {sc['foam']!r}")
     try:
-        check_foam(sc["foam"])  # true: refused, with the pointer to "auto"
+        check_foam(sc["foam"], per_image=False)  # "auto", false or one fraction (true: refused, pointing at "auto")
     except ValueError as e:
         raise ValueError(f"config: scene.{e}") from None
     try:

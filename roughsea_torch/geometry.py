@@ -23,6 +23,16 @@ __all__ = ["EARTH_RADIUS_M", "make_camera", "ViewGeometry", "view_geometry", "Ca
 EARTH_RADIUS_M = 6_371_000.0
 
 
+def check_pose(hfov_deg: Any, altitude_m: Any, pitch_deg: Any, yaw_deg: Any, roll_deg: Any) -> None:
+    """``ValueError`` naming the field unless the pose is one :func:`make_camera` accepts: hfov in
+    (0, 179] deg, altitude > 0 m, pitch in [−90, 90] deg, yaw finite, roll in [−180, 180] deg."""
+    check_finite_range("hfov_deg", hfov_deg, 0.0, 179.0, lo_open=True, unit="deg")
+    check_finite_range("altitude_m", altitude_m, 0.0, lo_open=True, unit="m (the camera must be above the sea)")
+    check_finite_range("pitch_deg", pitch_deg, -90.0, 90.0, unit="deg")
+    check_finite_range("yaw_deg", yaw_deg)
+    check_finite_range("roll_deg", roll_deg, -180.0, 180.0, unit="deg")
+
+
 def make_camera(
     height: int = 512,
     width: int = 640,
@@ -69,11 +79,7 @@ def make_camera(
         batch_size = sizes.pop() if len(sizes) == 1 else 1
     if sizes - {batch_size}:
         raise ValueError(f"pose tensors disagree on the batch size: {sorted(sizes | {batch_size})}")
-    check_finite_range("hfov_deg", hfov_deg, 0.0, 179.0, lo_open=True, unit="deg")
-    check_finite_range("altitude_m", altitude_m, 0.0, lo_open=True, unit="m (the camera must be above the sea)")
-    check_finite_range("pitch_deg", pitch_deg, -90.0, 90.0, unit="deg")
-    check_finite_range("yaw_deg", yaw_deg)
-    check_finite_range("roll_deg", roll_deg, -180.0, 180.0, unit="deg")
+    check_pose(hfov_deg, altitude_m, pitch_deg, yaw_deg, roll_deg)
     B = batch_size
     d2r = math.pi / 180.0
     hfov = per_batch("hfov_deg", hfov_deg, B, dtype, device) * d2r

@@ -18,7 +18,7 @@ from typing import Any, Callable, Sequence
 import torch
 
 from ._validation import check_finite_range
-from .geometry import make_camera
+from .geometry import check_pose, make_camera
 from .waves import check_time
 
 __all__ = ["PlatformMotion", "render_clip"]
@@ -64,16 +64,13 @@ class PlatformMotion:
         check_finite_range("phase_rad", self.phase_rad, unit="rad")
         check_finite_range("height", self.height, 1.0, unit="px")
         check_finite_range("width", self.width, 1.0, unit="px")
-        check_finite_range("hfov_deg", self.hfov_deg, 0.0, 179.0, lo_open=True, unit="deg")
-        check_finite_range("altitude_m", self.altitude_m, 0.0, lo_open=True, unit="m (the camera must be above the sea)")
-        check_finite_range("yaw_deg", self.yaw_deg, unit="deg")
+        check_pose(self.hfov_deg, self.altitude_m, self.pitch_deg, self.yaw_deg, self.roll_deg)  # make_camera's
         low = torch.as_tensor(self.altitude_m, dtype=torch.float64) - torch.as_tensor(self.heave_amplitude_m, dtype=torch.float64)
         if bool((low <= 0).any()):
             raise ValueError("heave_amplitude_m: must stay below altitude_m (the sensor must stay above the sea)")
         # the pose ± amplitude must stay within make_camera's ranges at every time, checked here (where the
         # amplitude can be named) rather than at the first frame that leaves them
         for mean, amp, lim in (("pitch_deg", "pitch_amplitude_deg", 90.0), ("roll_deg", "roll_amplitude_deg", 180.0)):
-            check_finite_range(mean, getattr(self, mean), -lim, lim, unit="deg")
             m = torch.as_tensor(getattr(self, mean), dtype=torch.float64)
             a = torch.as_tensor(getattr(self, amp), dtype=torch.float64)
             if bool(((m - a) < -lim).any() or ((m + a) > lim).any()):
