@@ -91,9 +91,9 @@ def check_foam(foam: Any, per_image: bool = True) -> Any:
             raise ValueError(f"foam must be 'auto', False or a fraction in [0, 1]; got {foam!r}")
         return foam
     check_finite_range("foam", foam, 0.0, 1.0)
-    if not per_image and isinstance(foam, (torch.Tensor, np.ndarray)) and foam.ndim > 0:
-        raise ValueError(f"foam: one setting for every image ('auto', False or a float in [0, 1]); got shape "
-                         f"{tuple(foam.shape)} (per-image fractions belong in a SeaScene)")
+    if not per_image and (isinstance(foam, (list, tuple)) or (isinstance(foam, (torch.Tensor, np.ndarray)) and foam.ndim > 0)):
+        raise ValueError(f"foam: one setting for every image ('auto', False or a float in [0, 1]); got {foam!r} "
+                         "(per-image fractions belong in a SeaScene)")
     return foam
 
 
