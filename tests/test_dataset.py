@@ -364,3 +364,5 @@ def test_foam_off_in_the_config_reaches_the_shards(tmp_path):
         resolve_config(dict(CFG, scene=dict(CFG["scene"], foam="maybe")))
     with pytest.raises(ValueError, match="scene.foam"):
         resolve_config(dict(CFG, scene=dict(CFG["scene"], foam=1.5)))
+    with pytest.raises(ValueError, match="scene.foam: one setting for every image"):
+        resolve_config(dict(CFG, scene=dict(CFG["scene"], foam=[0.1, 0.2])))
