@@ -50,7 +50,7 @@ from .expectation import Quadrature
 from .geometry import EARTH_RADIUS_M, make_camera
 from .motion import PlatformMotion
 from .radiometry import LWIR, as_band, band_radiance, brightness_temperature
-from .render import SeaScene, TableSize, _chunk_images, check_foam, render
+from .render import SeaScene, TableSize, images_per_chunk, check_foam, render
 from .sensor import SensorModel
 from .waves import check_time
 
@@ -477,7 +477,7 @@ def _render_frames(
                 frame_scene.time_s = pose["time_s"][:, t]
             cam_t = dict(cam, altitude_m=pose["altitude_m"][:, t], pitch_deg=pose["pitch_deg"][:, t],
                          roll_deg=pose["roll_deg"][:, t])
-            jobs.append((idx, t, cam_t, frame_scene, not tex and idx.numel() <= _chunk_images(frame_scene)))
+            jobs.append((idx, t, cam_t, frame_scene, not tex and idx.numel() <= images_per_chunk(frame_scene)))
 
     def run(job: tuple) -> None:
         idx, t, cam_t, frame_scene, _ = job

@@ -68,7 +68,7 @@ def _cached_one(cache: dict, key: Any, load: Any) -> Any:
     return value
 
 
-def _chunk_images(scene: Any, chunk: Any = None) -> Any:
+def images_per_chunk(scene: Any, chunk: Any = None) -> Any:
     """Images per chunk of pixels: ``chunk`` if given (render checks it), else 1 for a textured scene
     (its per-pixel work holds a dozen more full-size temporaries) and ``DEFAULT_CHUNK`` otherwise."""
     return chunk if chunk is not None else 1 if scene.seed is not None else DEFAULT_CHUNK
@@ -1001,7 +1001,7 @@ def render(
                        quadrature=quadrature, geometry=geometry, chunk=chunk)
 
     ref = geometry.cos_view_zenith if geometry is not None else getattr(cameras, "intrinsics", None)
-    per_chunk = _chunk_images(scene, chunk)
+    per_chunk = images_per_chunk(scene, chunk)
     if (method == "table" and isinstance(ref, torch.Tensor) and ref.ndim > 0 and isinstance(per_chunk, int)
             and ref.shape[0] <= per_chunk):
         return one_thread(call, ref.device)
@@ -1023,7 +1023,7 @@ def _render(
     """:func:`render`'s body."""
     if method not in ("table", "direct"):
         raise ValueError(f"method must be 'table' or 'direct'; got {method!r}")
-    chunk = _chunk_images(scene, chunk)
+    chunk = images_per_chunk(scene, chunk)
     if output not in ("radiance", "brightness_temperature"):
         raise ValueError(f"output must be 'radiance' or 'brightness_temperature'; got {output!r}")
     if geometry is not None:
