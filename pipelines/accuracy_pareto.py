@@ -304,7 +304,7 @@ def run_renderer(calm: bool, cfg: dict, args) -> tuple[list[Point], dict]:
     H, W = (16, 24) if args.quick else ((24, 32) if calm else (48, 64))
     cams32, scene = render_cases(H, W, calm, F32)
     g32 = rs.view_geometry(cams32)
-    g64 = ViewGeometry(g32.cos_view_zenith.double(), g32.is_sea, g32._dx.double(), g32._dy.double(), None)
+    g64 = ViewGeometry(g32.cos_view_zenith.double(), g32.is_sea, g32.dx.double(), g32.dy.double(), None)
     g64.altitude_m = g32.altitude_m.double()
     sea = g32.is_sea[:, None]
     t0 = time.perf_counter()

@@ -1,6 +1,6 @@
 """Accuracy of the textured table render against per-pixel evaluation, from grazing to straight down.
 
-The table method reads each sea pixel's texture from a volume computed at nodes (``clutter.TextureTable``);
+The table method reads each sea pixel's texture from a volume computed at nodes (``renderer.texture.TextureTable``);
 ``method="direct"`` evaluates the two-scale model at every pixel. This sweeps the view from grazing
 to nadir (pitch −1° … −90°, 30° field of view, 24×32 pixels), two heights (20 and 300 m), three
 winds (3, 8, 15 m/s), float32 and float64, one realization each (seed 12, t = 1.5 s, whitecaps off

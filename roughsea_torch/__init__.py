@@ -34,14 +34,13 @@ from .radiometry import (
 )
 from .sky import ConstantSky, TabulatedSky
 from .geometry import EARTH_RADIUS_M, ViewGeometry, make_camera, view_geometry
-from .render import SeaRenderer, SeaScene, TableSize, render
-from ._pixels import release_workspace
+from .renderer import SeaRenderer, SeaScene, TableSize, release_workspace, render
 from .sensitivity import pixel_derivative
 from .slopes import SlopeStatistics, slope_pdf
 from .waves import WaveField, elfouhaily_spectrum
 from .motion import PlatformMotion, render_clip
 from .sun import Sun, glint_radiance
-from . import atmosphere, augmentation, clutter, dataset, foam, sensor, sun, waves  # noqa: E402  (submodules as attributes: rs.sensor, ...)
+from . import atmosphere, augmentation, clutter, dataset, foam, renderer, sensor, sun, waves  # noqa: E402  (submodules as attributes: rs.sensor, ...)
 from .augmentation import RandomSeaBackground, RandomSeaClip, SceneSampler
 from .dataset import SeaShardDataset
 from .sensor import SensorModel
@@ -52,6 +51,7 @@ __all__ = [
     "atmosphere",
     "augmentation",
     "clutter",
+    "renderer",
     "foam",
     "sun",
     "waves",

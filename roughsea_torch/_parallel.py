@@ -26,7 +26,7 @@ compositing augmentation (8 images in three atmosphere groups, one chunk each) 1
 now 0.99× and 0.96×, and 1.10× and 0.96× (``docs/bench_augmentation_before_70b4f89.md``,
 ``docs/bench_augmentation.md``). Hundreds of parallel regions each wait for a thread that the
 other process has descheduled. A render of one chunk runs on one intra-op thread from start to
-end (:func:`~roughsea_torch.render.render`). A render of several chunks leaves its own
+end (:func:`~roughsea_torch.renderer.render`). A render of several chunks leaves its own
 preparation (under 2 ms) at the caller's setting: on one intra-op thread it made the workers'
 chunks that followed take 1.1× as long on an idle machine, for a reason not found.
 """

@@ -50,7 +50,7 @@ from .expectation import Quadrature
 from .geometry import EARTH_RADIUS_M, make_camera
 from .motion import PlatformMotion
 from .radiometry import LWIR, as_band, band_radiance, brightness_temperature
-from .render import SeaScene, TableSize, images_per_chunk, check_foam, render
+from .renderer import SeaScene, TableSize, check_foam, images_per_chunk, render
 from .sensor import SensorModel
 from .waves import check_time
 
@@ -753,7 +753,7 @@ class RandomSeaBackground(_Seas, IntensityAugmentationBase2D):
             per image from those generators); another module is called image by image.
         output: ``"radiance"``, ``"brightness_temperature"`` [K], or ``"sensor"`` (the sensor
             model's output, e.g. counts; the default when a sensor is given).
-        table, quadrature, path: renderer settings (see :func:`~roughsea_torch.render.render`).
+        table, quadrature, path: renderer settings (see :func:`~roughsea_torch.renderer.render`).
         foam: the whitecaps, as ``SeaScene(foam=)``: ``"auto"`` (default: Monahan's fraction at
             each image's wind, on the crests of a textured sea), ``False`` (none: a sea without
             whitecaps, e.g. where the model's dark whitecaps near grazing are not wanted;

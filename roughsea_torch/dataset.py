@@ -67,7 +67,7 @@ from .augmentation import (
     render_parameters,
 )
 from .radiometry import LWIR, MWIR, SpectralBand, as_band
-from .render import check_foam
+from .renderer import check_foam
 
 __all__ = ["DEFAULT_CONFIG", "resolve_config", "build_sensor", "generate", "SeaShardDataset", "shard_name",
            "frame_render_parameters"]

@@ -18,7 +18,8 @@ from kornia.geometry.depth import unproject_meshgrid
 
 from ._validation import check_finite_range, per_batch
 
-__all__ = ["EARTH_RADIUS_M", "make_camera", "ViewGeometry", "view_geometry", "CameraGeometry"]
+__all__ = ["EARTH_RADIUS_M", "make_camera", "ViewGeometry", "view_geometry", "CameraGeometry", "slant_range",
+           "turned_axes", "ray_component"]
 
 EARTH_RADIUS_M = 6_371_000.0
 
@@ -128,6 +129,8 @@ class ViewGeometry:
         view_azimuth: world azimuth of the LOS sea → sensor (sea pixels) or of the reversed ray
             (sky pixels) [rad], from +x towards +y, in (−π, π].
         is_sea: the ray meets the sea.
+        dx, dy: the unit ray's world x and y components (camera → scene); the line of sight sea →
+            sensor is −(dx, dy) horizontally.
         range_m: slant range to the sea [m] (inf for sky pixels).
         altitude_m: (B,) altitude of each camera above the sea [m].
 
@@ -138,7 +141,7 @@ class ViewGeometry:
     def __init__(self, cos_view_zenith, is_sea, dx, dy, rng_fn):
         self.cos_view_zenith = cos_view_zenith
         self.is_sea = is_sea
-        self._dx, self._dy, self._rng_fn = dx, dy, rng_fn
+        self.dx, self.dy, self._rng_fn = dx, dy, rng_fn
         self._cache: dict[str, torch.Tensor] = {}
 
     @property
@@ -150,7 +153,7 @@ class ViewGeometry:
     @property
     def view_azimuth(self) -> torch.Tensor:
         if "va" not in self._cache:
-            self._cache["va"] = torch.atan2(-self._dy, -self._dx)
+            self._cache["va"] = torch.atan2(-self.dy, -self.dx)
         return self._cache["va"]
 
     @property
@@ -192,6 +195,18 @@ def view_geometry(
     return out
 
 
+def slant_range(cos_t: torch.Tensor, altitude: torch.Tensor, earth_radius_m: float) -> torch.Tensor:
+    """Slant range [m] from a sensor at altitude h to the sea point whose LOS has local zenith
+    cosine cos θ̂: the near root of (R + h)² = R² + 2 R r cos θ̂ + r², written without cancellation
+    as h (2R + h) / (R cos θ̂ + √(R² cos² θ̂ + h (2R + h))) (flat sea: h / cos θ̂)."""
+    c = cos_t.clamp(0.0, 1.0)
+    if math.isinf(earth_radius_m):
+        return altitude / c.clamp_min(1e-12)
+    num = altitude * (2.0 * earth_radius_m + altitude)
+    rc = earth_radius_m * c
+    return num / (rc + torch.sqrt(rc * rc + num))
+
+
 def turned_axes(A: torch.Tensor, offset: torch.Tensor) -> torch.Tensor:
     """World x and y axes turned by −``offset`` (b,) [rad], in camera axes (b, 2, 3), from ``A`` (b, 3, 3)
     (world x, y, vertical in camera axes): x' = cos o x − sin o y, y' = sin o x + cos o y, so that a
@@ -200,7 +215,7 @@ def turned_axes(A: torch.Tensor, offset: torch.Tensor) -> torch.Tensor:
     return torch.stack([co * A[:, 0] - so * A[:, 1], so * A[:, 0] + co * A[:, 1]], 1)
 
 
-def _component(a: torch.Tensor, x: torch.Tensor, y: torch.Tensor, inv: torch.Tensor | None,
+def ray_component(a: torch.Tensor, x: torch.Tensor, y: torch.Tensor, inv: torch.Tensor | None,
                out: torch.Tensor | None = None) -> torch.Tensor:
     """a · (x, y, 1) / |(x, y, 1)|: a world axis ``a`` (b, 3, ...) in camera axes against the unit ray
     of normalized image coordinates (x, y) (``inv`` = 1/|(x, y, 1)|), broadcast over (x, y); into
@@ -275,8 +290,8 @@ class CameraGeometry:
 
             def comp(i: int) -> torch.Tensor:
                 if i < 2 and azimuth_offset is not None:  # unnormalized, along the turned axes
-                    return _component(A_t[:, i, :, None, None], x, y, None)
-                return _component(A[:, i, :, None, None], x, y, inv)
+                    return ray_component(A_t[:, i, :, None, None], x, y, None)
+                return ray_component(A[:, i, :, None, None], x, y, inv)
         else:
             rays = unproject_meshgrid(H, W, K, normalize_points=True, device=self.device, dtype=self.dtype)
 
@@ -336,7 +351,7 @@ class CameraGeometry:
         x, y = xy[..., 0], xy[..., 1]
         inv = torch.rsqrt(x * x + y * y + 1.0)
         A = self.axes_cam[sl, :, :, None]
-        return tuple(_component(A[:, i], x, y, inv) for i in (2, 0, 1))
+        return tuple(ray_component(A[:, i], x, y, inv) for i in (2, 0, 1))
 
     def border(self, sl: slice = slice(None)) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """Ray components (dz, dx, dy), each (b, 2(H + W) − 4), of the pixels on the image's border,

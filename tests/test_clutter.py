@@ -105,7 +105,7 @@ def test_far_field_is_the_expectation_image():
     tex = rs.render(cams, _scene([3]))
     mean = rs.render(cams, _scene(None))
     # equal but for rounding: the expectation render reads its table through a cheaper azimuth
-    # coordinate (render._azimuth_ratio) than the textured one (the angle): 4e-12 apart here
+    # coordinate (renderer.coordinates.azimuth_ratio) than the textured one (the angle): 4e-12 apart here
     assert torch.allclose(tex, mean, rtol=1e-11, atol=0)
     # and the same scene seen from nearer does carry texture (the check above is not vacuous)
     near = _cams(1, pitch=-6.0)

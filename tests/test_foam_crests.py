@@ -21,7 +21,8 @@ import pytest
 import torch
 
 import roughsea_torch as rs
-from roughsea_torch.clutter import TextureTable, footprint
+from roughsea_torch.clutter import footprint
+from roughsea_torch.renderer.texture import TextureTable
 from roughsea_torch.foam import crest_foam_fraction, whitecap_fraction
 from roughsea_torch.waves import WaveField
 
@@ -348,7 +349,7 @@ def test_texture_table_returns_the_pixels_crest(monkeypatch):
     cos_t = geom.cos_view_zenith.clamp_min(1e-9)
     R = torch.where(sea, geom.range_m, torch.ones_like(cos_t))
     L = footprint(R, cos_t, (1.0 / cams.fx)[:, None, None])
-    s = field.sample(centres[:, 0, None, None] + R * geom._dx, centres[:, 1, None, None] + R * geom._dy, times,
+    s = field.sample(centres[:, 0, None, None] + R * geom.dx, centres[:, 1, None, None] + R * geom.dy, times,
                      footprint=L, elevation=False, crest=True)
     rms = float(s["crest"][sea].pow(2).mean().sqrt())
     assert float((x_r - s["crest"])[sea].abs().max()) < 1e-9 * rms

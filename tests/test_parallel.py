@@ -111,7 +111,7 @@ def test_a_lone_chunk_runs_on_one_thread_more_chunks_on_the_workers(two_threads,
         setup.append(torch.get_num_threads())
         return resolved(self, *a, **k)
 
-    monkeypatch.setattr(sys.modules["roughsea_torch.render"], "map_chunks", spy_map)
+    monkeypatch.setattr(sys.modules["roughsea_torch.renderer.table"], "map_chunks", spy_map)
     monkeypatch.setattr(rs.SeaScene, "resolved", spy_setup)
     wind = torch.tensor([3.0, 6.0, 9.0, 12.0])
     two = rs.render(_cams(), _scene(wind), chunk=2)
@@ -246,7 +246,7 @@ def test_textured_render_of_two_images_uses_the_workers(two_threads, monkeypatch
             return fn(x)
         return map_chunks(wrapped, items, device)
 
-    monkeypatch.setattr(sys.modules["roughsea_torch.render"], "map_chunks", spy_map)
+    monkeypatch.setattr(sys.modules["roughsea_torch.renderer.table"], "map_chunks", spy_map)
     cams = rs.make_camera(16, 20, altitude_m=20.0, pitch_deg=-6.0, batch_size=2)
     rs.render(cams, rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, seed=[1, 2]))
     assert len(names) >= 2 and all(n.startswith("roughsea") for n in names)

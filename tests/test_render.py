@@ -429,7 +429,7 @@ def test_correlated_slopes_unfolded_azimuth_matches_direct():
 @pytest.mark.parametrize("anisotropic", [False, True])
 def test_workspace_reused_across_calls_and_equal_to_the_autograd_path(anisotropic):
     """Without gradients through the rays, the per-pixel chain runs in place in a per-thread workspace
-    kept between calls (roughsea_torch._pixels). A render repeated after renders of other cameras,
+    kept between calls (roughsea_torch.renderer.pixels). A render repeated after renders of other cameras,
     shapes and dtypes, and after release_workspace, is bit-identical; and it equals the general path
     (taken when the pose requires grad) to float32 rounding (2.4e-7 relative measured), sea and sky."""
     scene = rs.SeaScene(wind_speed=torch.tensor([2.0, 10.0, 25.0, 0.0, 40.0]), anisotropic=anisotropic,
@@ -443,7 +443,7 @@ def test_workspace_reused_across_calls_and_equal_to_the_autograd_path(anisotropi
     assert torch.equal(rs.render(cams, scene), first)
     rs.release_workspace()
     assert torch.equal(rs.render(cams, scene), first)
-    from roughsea_torch import _pixels
+    from roughsea_torch.renderer import pixels as _pixels
     assert _pixels._spaces  # the in-place path ran (it holds a workspace again)
     alt = torch.tensor([20.0, 200.0, 2000.0, 5.0, 20.0], requires_grad=True)
     cams_grad = rs.make_camera(64, 80, hfov_deg=torch.tensor([30.0, 30.0, 60.0, 10.0, 40.0]), altitude_m=alt,
@@ -483,8 +483,8 @@ def test_wind_direction_gradient_through_the_table_coordinates():
 
 def test_workspace_of_an_ended_thread_is_dropped():
     """A thread that rendered and ended leaves no workspace behind once another thread allocates one
-    (roughsea_torch._pixels keys them by thread; the planes of ended threads were kept)."""
-    from roughsea_torch import _pixels
+    (roughsea_torch.renderer.pixels keys them by thread; the planes of ended threads were kept)."""
+    from roughsea_torch.renderer import pixels as _pixels
 
     scene = rs.SeaScene(wind_speed=6.0, sea_temperature=290.0, sky=sky)
     rs.release_workspace()

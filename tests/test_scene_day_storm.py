@@ -120,7 +120,7 @@ def test_day_sky_pixels_add_the_scattered_sky_by_zenith_and_azimuth():
     day = rs.render(cams, _day_scene(sun_azimuth=sun_az))[:, 0]
     night = rs.render(cams, rs.SeaScene(wind_speed=0.5, sea_temperature=290.0, band=rs.MWIR, path=False, foam=False))[:, 0]
     ds = load_scattered_sky("midlatitude_summer", rs.MWIR, aerosol="maritime")
-    want = ds(g.cos_view_zenith, torch.atan2(g._dy, g._dx) - sun_az, torch.full_like(g.cos_view_zenith, math.radians(60.0)))
+    want = ds(g.cos_view_zenith, torch.atan2(g.dy, g.dx) - sun_az, torch.full_like(g.cos_view_zenith, math.radians(60.0)))
     torch.testing.assert_close(day - night, want, rtol=1e-9, atol=1e-12)
     assert float((day - night)[0].mean()) > 1.5 * float((day - night)[1].mean())  # yaw 0 looks towards the sun
 
@@ -140,7 +140,7 @@ def test_day_sky_reflected_by_a_calm_sea_along_the_mirror_azimuth():
     scene = _day_scene()
     plus = (rs.render(cams, scene)[:, 0] - rs.render(cams, _day_scene(aerosol=None))[:, 0]).reshape(-1)
     ds = load_scattered_sky("midlatitude_summer", rs.MWIR, aerosol="maritime")
-    look = torch.atan2(g._dy, g._dx).reshape(-1)  # the rays' world azimuths: the mirror direction
+    look = torch.atan2(g.dy, g.dx).reshape(-1)  # the rays' world azimuths: the mirror direction
     th, ph = g.view_zenith.reshape(-1), g.view_azimuth.reshape(-1)
     z = scene.sky.zenith.double()
     sun_z = math.radians(60.0)

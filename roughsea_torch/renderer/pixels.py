@@ -15,7 +15,7 @@ cameras' pose and intrinsics nor the per-image maps, e.g. through ``wind_directi
 is off): in-place operations would otherwise overwrite what autograd saved, and ``out=`` does not
 record gradients. The grid passed to ``grid_sample`` is fresh memory when the table itself requires grad
 (``grid_sample`` saves the grid for the table's gradient). The formulas are those of the general
-path in :func:`roughsea_torch.render._render_table` (the same table coordinates to rounding).
+path in :mod:`roughsea_torch.renderer.table` (the same table coordinates to rounding).
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from typing import Any
 
 import torch
 
-from .geometry import CameraGeometry, _component, turned_axes
+from ..geometry import CameraGeometry, ray_component, turned_axes
 
 __all__ = ["release_workspace"]
 
@@ -72,7 +72,7 @@ def table_grid(cg: CameraGeometry, sl: slice, xy: tuple[torch.Tensor, torch.Tens
     ``sea_map`` = (k, b), gy = b + k ζ for sea pixels, ζ = asinh(cos θ̂/ε); ``sky_map`` = (k, b),
     gy = b + k dz for sky pixels (None: no pixel sees sky); ``az`` None (isotropic: gx = 0) or
     {"offset": (b,), "k": , "b": , "fold": bool}, gx = b + k u with u the azimuth ratio of
-    :func:`roughsea_torch.render._azimuth_ratio`. The mask is workspace memory: valid until the
+    :func:`roughsea_torch.renderer.coordinates.azimuth_ratio`. The mask is workspace memory: valid until the
     thread's next call.
     """
     x, y = xy
@@ -84,7 +84,7 @@ def table_grid(cg: CameraGeometry, sl: slice, xy: tuple[torch.Tensor, torch.Tens
     A = cg.axes_cam[sl]
     # z = c1 dz, dz the unit ray's local-vertical component (c1 folded into the axis: no extra pass)
     torch.add(x * x, y * y + 1.0, out=P0).rsqrt_()
-    z = _component((c1[:, :, 0] * A[:, 2])[:, :, None, None], x, y, P0, out=P1)
+    z = ray_component((c1[:, :, 0] * A[:, 2])[:, :, None, None], x, y, P0, out=P1)
     ch = c1 * sh
     torch.lt(z, -ch, out=seaf)
     # ζ = asinh √q = ½ log(2q + 1 + 2√(q² + q)), q = z² − (c1 sh)², held at a tiny q > 0 off the
@@ -102,7 +102,7 @@ def table_grid(cg: CameraGeometry, sl: slice, xy: tuple[torch.Tensor, torch.Tens
         gx.zero_()
     else:  # the ray's components along the world axes turned by −offset (unnormalized)
         A_t = turned_axes(A, az["offset"])
-        c, s = (_component(A_t[:, i, :, None, None], x, y, None, out=o) for i, o in ((0, P0), (1, gx)))
+        c, s = (ray_component(A_t[:, i, :, None, None], x, y, None, out=o) for i, o in ((0, P0), (1, gx)))
         if az["fold"]:  # u = |c| / (|c| + |s|)
             c.abs_()
             s.abs_().add_(c).clamp_min_(1e-30)

@@ -1,0 +1,136 @@
+"""The table method's settings: :class:`TableSize` (node counts of the per-image tables and of their
+fine resampling) and the chunking of a render (how many images' per-pixel temporaries are held at
+once). How the defaults were chosen, with the accuracy each setting buys against per-pixel
+evaluation: ``docs/notes/table_size.md``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from numbers import Integral, Real
+from typing import Any
+
+import numpy as np
+
+__all__ = ["TableSize", "DEFAULT_CHUNK", "FINE_OVERHANG", "images_per_chunk"]
+
+DEFAULT_CHUNK = 4  # images per chunk of an expectation render (render's ``chunk``; textured scenes: 1)
+FINE_OVERHANG = 2  # fine cells beyond each end of a node interval, so no pixel reads a table's clamped border
+
+
+def images_per_chunk(scene: Any, chunk: Any = None) -> Any:
+    """Images per chunk of pixels: ``chunk`` if given (render checks it), else 1 for a textured scene
+    (its per-pixel work holds a dozen more full-size temporaries) and ``DEFAULT_CHUNK`` otherwise."""
+    return chunk if chunk is not None else 1 if scene.seed is not None else DEFAULT_CHUNK
+
+
+@dataclass(frozen=True)
+class TableSize:
+    """Node counts of the table method: Chebyshev–Lobatto nodes at which the model is evaluated per
+    image, and the fine grids they are resampled to (read per pixel by bilinear ``grid_sample``).
+    The defaults keep the table within a few 1e-6 of per-pixel evaluation (``method="direct"``);
+    ``docs/notes/table_size.md`` has the measurements behind each.
+
+    The mean (expectation) table, over ζ = asinh(cos θ̂/ε) (θ̂ the view zenith, ε ~ a quarter of the
+    smallest rms slope) and the azimuth coordinate of the view from the upwind axis:
+
+    Args:
+        zenith: nodes in ζ.
+        azimuth: nodes in relative azimuth (anisotropic slopes only).
+        azimuth_thin, zenith_thin, fine_azimuth_thin: nodes in azimuth and in ζ, and fine columns,
+            when some image's slope ellipse is thin (minor/major rms slope < 0.2: Cox–Munk below
+            ~0.04 m/s, or |r| near 1), where R_a changes sharply with azimuth at grazing views.
+        zenith_narrow: nodes in ζ when some image's ellipse is narrow but not thin (ratio < 0.5).
+        azimuth_day: nodes in relative azimuth when the sea reflects a scattered daytime sky
+            (``SeaScene(aerosol=)``, tabulated piecewise linearly in azimuth). A render with every
+            azimuth in view (looking down at the nadir) or ``span="full"`` takes 2·azimuth_day − 1
+            nodes and twice ``fine_azimuth`` columns, and its texture 4·(texture_azimuth_sun − 1) + 1
+            nodes and four times ``fine_texture_azimuth`` columns, for the whole render.
+        glint, glint_tolerance: Chebyshev–Lobatto nodes per axis (ζ, azimuth) of the glint's smooth
+            factor L_sun G1 / D (sunny scenes without texture whose table runs over the unfolded
+            azimuth); each pixel applies the sharp factor P ρ t itself. An image whose table misses
+            ``glint_tolerance`` (relative to the radiance, at the fine cells' centres, checked
+            against direct evaluation) keeps the whole glint per pixel.
+        fine_zenith, fine_azimuth: rows and columns of the fine table.
+        fine_sky: rows of the sky block of the fine table, uniform in the cosine of the ray's zenith
+            over the span of the image's sky pixels.
+        span: ``"pixels"`` (default): nodes only over the angles the image's sea pixels span;
+            ``"full"``: over every angle (θ̂ in [0°, 90°], every azimuth), for comparison.
+
+    The texture volume of textured scenes (``SeaScene(seed=)``, :mod:`roughsea_torch.renderer.texture`):
+
+    Args:
+        texture: nodes in x = a/σ_a, the flat-point quantile of the resolved along-view slope,
+            Chebyshev–Lobatto over ±``texture_width``; beyond it the border value.
+        texture_zenith, texture_zenith_sun: ζ nodes of the texture (of a sunny scene, whose volume
+            also carries the visible quantile x' = a'/σ_a of each pixel's unresolved Gaussian).
+        texture_azimuth_sun: azimuth nodes of the texture of a sunny scene (on the mean table's span).
+        fine_texture, fine_texture_zenith, fine_texture_azimuth: the fine texture volume (x, ζ,
+            azimuth), read trilinearly per sea pixel.
+        texture_quadrature: (outer, inner) Gauss–Legendre nodes of the model at the texture nodes
+            (the departure from the mean is the difference of two evaluations on this rule).
+        texture_quadrature_steep, texture_steep_zenith_deg: the rule of the texture nodes whose view
+            zenith is below ``texture_steep_zenith_deg`` [deg].
+        texture_quadrature_width: half-width [standard deviations] of the Gaussian window of the
+            texture nodes' rule (the render's quadrature's, if narrower).
+        texture_min_band_share: per image, the octaves of the wave field that carry less than this
+            share of its slope variance (and of its crest variable's) are left out of the
+            realization, their variance left to the unresolved statistics; 0 keeps every band.
+
+    For accuracy finer than the defaults, e.g. MWIR day skies about the sun:
+    ``TableSize(texture_quadrature=(20, 16), texture_azimuth_sun=17, fine_texture_azimuth=64)``.
+    """
+
+    zenith: int = 17
+    azimuth: int = 7
+    fine_zenith: int = 3072
+    fine_azimuth: int = 64
+    span: str = "pixels"
+    azimuth_thin: int = 33
+    fine_sky: int = 2048
+    zenith_thin: int = 41
+    fine_azimuth_thin: int = 128
+    texture: int = 9
+    texture_zenith: int = 33
+    texture_zenith_sun: int = 65
+    texture_width: float = 4.5
+    fine_texture: int = 129
+    fine_texture_zenith: int = 512
+    fine_texture_azimuth: int = 16
+    texture_quadrature: tuple = (12, 16)
+    texture_quadrature_steep: tuple = (16, 16)
+    texture_steep_zenith_deg: float = 40.0
+    texture_quadrature_width: float = 4.5
+    texture_min_band_share: float = 1e-8
+    texture_azimuth_sun: int = 9
+    zenith_narrow: int = 21
+    azimuth_day: int = 25
+    glint: int = 33
+    glint_tolerance: float = 1e-5
+
+    def __post_init__(self) -> None:
+        if self.span not in ("pixels", "full"):
+            raise ValueError(f"TableSize.span must be 'pixels' or 'full'; got {self.span!r}")
+        for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin", "zenith_narrow", "azimuth_day", "texture",
+                     "texture_zenith", "texture_zenith_sun", "texture_azimuth_sun", "glint"):
+            if int(getattr(self, name)) < 2:
+                raise ValueError(f"TableSize.{name} must be >= 2")
+        for name in ("fine_zenith", "fine_azimuth", "fine_sky", "fine_azimuth_thin", "fine_texture",
+                     "fine_texture_zenith", "fine_texture_azimuth"):
+            if int(getattr(self, name)) < 4 * FINE_OVERHANG + 2:
+                raise ValueError(f"TableSize.{name} must be >= {4 * FINE_OVERHANG + 2}")
+        for name in ("texture_quadrature", "texture_quadrature_steep"):
+            rule = getattr(self, name)
+            if (not isinstance(rule, (tuple, list)) or len(rule) != 2
+                    or not all(isinstance(v, Integral) and not isinstance(v, (bool, np.bool_)) and 1 <= v <= 512
+                               for v in rule)):
+                raise ValueError(f"TableSize.{name} must be (outer, inner), two ints in [1, 512]; got {rule!r}")
+            object.__setattr__(self, name, tuple(int(v) for v in rule))  # hashable (tables are cached by it)
+        for name, lo, hi in (("texture_steep_zenith_deg", 0.0, 90.0), ("texture_quadrature_width", 1.0, 40.0)):
+            v = getattr(self, name)
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real) or not lo <= float(v) <= hi:
+                raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")
+            object.__setattr__(self, name, float(v))
+        share = self.texture_min_band_share
+        if isinstance(share, bool) or not isinstance(share, (int, float)) or not 0.0 <= float(share) < 1.0:
+            raise ValueError(f"TableSize.texture_min_band_share must be a number in [0, 1); got {share!r}")
