@@ -46,6 +46,7 @@ from kornia.augmentation import IntensityAugmentationBase2D
 
 from ._parallel import map_chunks, one_thread
 from ._validation import check_finite_range
+from .atmosphere import available_atmospheres, load_path, surface_air_temperature
 from .expectation import Quadrature
 from .geometry import EARTH_RADIUS_M, make_camera
 from .motion import PlatformMotion
@@ -243,8 +244,6 @@ class SceneSampler:
             raise ValueError(f"path must be True or False; got {path!r}")
         if not isinstance(texture, bool):
             raise ValueError(f"texture must be True or False; got {texture!r}")
-        from .atmosphere import available_atmospheres, load_path, surface_air_temperature
-
         names = [atmospheres] if isinstance(atmospheres, str) else list(atmospheres)
         if not names:
             raise ValueError("atmospheres: give at least one atmosphere name")

@@ -45,6 +45,7 @@ from __future__ import annotations
 import copy
 import hashlib
 import inspect
+import io
 import json
 import math
 import os
@@ -66,8 +67,10 @@ from .augmentation import (
     render_clip_parameters,
     render_parameters,
 )
+from ._version import __version__
 from .radiometry import LWIR, MWIR, SpectralBand, as_band
 from .render import check_foam
+from .sensor import DetectorNoise, FixedPatternNoise, OpticsBlur, SensorModel, ToCounts
 
 __all__ = ["DEFAULT_CONFIG", "resolve_config", "build_sensor", "generate", "SeaShardDataset", "shard_name",
            "frame_render_parameters"]
@@ -94,7 +97,10 @@ DEFAULT_CONFIG: dict[str, Any] = {
     },
 }
 _BANDS = {"LWIR": LWIR, "MWIR": MWIR}
-_SENSOR_STAGES = ("blur", "noise", "fixed_pattern", "counts")
+# the sensor stages a config may set, in SensorModel's order, and their classes
+_STAGE_CLASSES: dict[str, type] = {"blur": OpticsBlur, "noise": DetectorNoise, "fixed_pattern": FixedPatternNoise,
+                                   "counts": ToCounts}
+_SENSOR_STAGES = tuple(_STAGE_CLASSES)
 
 
 def shard_name(k: int) -> str:
@@ -120,12 +126,6 @@ def _sampler(scene: dict[str, Any], motion: dict[str, Any] | None = None) -> Sce
 def _config_sampler(cfg: dict[str, Any]) -> SceneSampler:
     """The sampler of a resolved config: with motion when it makes clips."""
     return _sampler(cfg["scene"], cfg["motion"] if cfg["clip_length"] > 1 else None)
-
-
-def _stage_classes() -> dict[str, type]:
-    from . import sensor as S
-
-    return {"blur": S.OpticsBlur, "noise": S.DetectorNoise, "fixed_pattern": S.FixedPatternNoise, "counts": S.ToCounts}
 
 
 def _check_keys(where: str, given: dict[str, Any], allowed: set[str]) -> None:
@@ -221,8 +221,7 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
     bits = cfg["sensor"]["counts"].get("bits", 14)
     if not isinstance(bits, int) or not 1 <= bits <= 16:
         raise ValueError(f"config: sensor.counts.bits must be an integer in [1, 16] (16-bit shards); got {bits!r}")
-    classes = _stage_classes()
-    for stage, cls in classes.items():
+    for stage, cls in _STAGE_CLASSES.items():
         settings = cfg["sensor"][stage]
         if settings is False:
             continue
@@ -234,11 +233,9 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
 
 def build_sensor(cfg: dict[str, Any]) -> torch.nn.Module:
     """The ``SensorModel`` of a resolved config (stages set to ``false`` are left out)."""
-    from .sensor import SensorModel
-
     band = _band(cfg["scene"]["band"])
     stages: dict[str, Any] = {}
-    for stage, cls in _stage_classes().items():
+    for stage, cls in _STAGE_CLASSES.items():
         settings = cfg["sensor"][stage]
         if settings is False:
             stages[stage] = None
@@ -257,8 +254,6 @@ def _atomic_write(path: Path, write: Callable[[Any], None], crash_after_bytes: i
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
     with open(tmp, "wb") as f:
         if crash_after_bytes is not None:  # testing hook: die in the middle of a write
-            import io
-
             buf = io.BytesIO()
             write(buf)
             f.write(buf.getvalue()[:crash_after_bytes])
@@ -401,8 +396,6 @@ def num_shards(cfg: dict[str, Any]) -> int:
 
 
 def _metadata(cfg: dict[str, Any]) -> dict[str, Any]:
-    from . import __version__
-
     band = _band(cfg["scene"]["band"])
     return {"config": cfg, "band_m": [band.lo, band.hi], "roughsea_torch": __version__,
             "torch": torch.__version__.split("+")[0], "num_shards": num_shards(cfg),
@@ -482,7 +475,7 @@ def generate(
                                              persistent_workers=False)
         bar = None
         if progress:
-            from tqdm import tqdm
+            from tqdm import tqdm  # an optional dependency (the "test" and "pipelines" extras): imported when used
 
             bar = tqdm(total=sum(min(cfg["shard_size"], cfg["num_images"] - k * cfg["shard_size"]) for k in todo),
                        unit="img" if cfg["clip_length"] == 1 else "clip", desc=f"rank {rank} shards", dynamic_ncols=True)

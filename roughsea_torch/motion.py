@@ -19,6 +19,7 @@ import torch
 
 from ._validation import check_finite_range
 from .geometry import check_pose, make_camera
+from .render import render
 from .waves import check_time
 
 __all__ = ["PlatformMotion", "render_clip"]
@@ -130,8 +131,6 @@ def render_clip(
     within [−1e9, 1e9] s (``roughsea_torch.waves.MAX_TIME_S``, the range ``SeaScene(time_s=)`` and
     ``WaveField.sample`` accept), else a ``ValueError`` naming the argument.
     """
-    from .render import render
-
     check_time("times_s", times_s)
     times = torch.as_tensor(times_s.detach() if isinstance(times_s, torch.Tensor) else times_s, dtype=torch.float64)
     if times.ndim > 1 or times.numel() == 0:
@@ -146,7 +145,7 @@ def render_clip(
     frames = []
     it = times.tolist()
     if progress:
-        from tqdm.auto import tqdm
+        from tqdm.auto import tqdm  # an optional dependency: imported when a progress bar is asked for
 
         it = tqdm(it, desc="frames", unit="frame")
     for t in it:
