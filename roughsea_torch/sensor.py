@@ -38,7 +38,7 @@ from torch import nn
 
 from ._validation import as_tensor, check_finite_range, per_batch, resolve_dtype_device
 from ._parallel import one_thread
-from .radiometry import LWIR, _planck_dT, as_band, band_radiance, band_radiance_slope
+from .radiometry import LWIR, as_band, band_radiance, band_radiance_slope, planck_radiance_derivative
 
 __all__ = [
     "optics_blur",
@@ -138,7 +138,7 @@ def _band_radiance_dT(temperature: torch.Tensor, band: Any) -> torch.Tensor:
     t = temperature.unsqueeze(-1)
     out = torch.zeros_like(temperature)
     for s in range(0, n, chunk):
-        out = out + (_planck_dT(lam[s:s + chunk], t) * w[s:s + chunk]).sum(-1)
+        out = out + (planck_radiance_derivative(lam[s:s + chunk], t) * w[s:s + chunk]).sum(-1)
     return out
 
 
