@@ -55,21 +55,20 @@ from typing import Any, Callable, Iterator
 import numpy as np
 import torch
 
-from .augmentation import (
+from ._version import __version__
+from .parameter_render import render_clip_parameters, render_parameters
+from .radiometry import LWIR, MWIR, SpectralBand, as_band
+from .render import check_foam
+from .sampling import (
     DEFAULT_TIME_S,
     MOTION_FIELDS,
     SCENE_FIELDS,
     SUN_FIELDS,
     SceneSampler,
-    _range,
+    as_range,
     frame_parameters,
     image_seed,
-    render_clip_parameters,
-    render_parameters,
 )
-from ._version import __version__
-from .radiometry import LWIR, MWIR, SpectralBand, as_band
-from .render import check_foam
 from .sensor import DetectorNoise, FixedPatternNoise, OpticsBlur, SensorModel, ToCounts
 
 __all__ = ["DEFAULT_CONFIG", "resolve_config", "build_sensor", "generate", "SeaShardDataset", "shard_name",
@@ -205,7 +204,7 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
             _sampler(sc, cfg["motion"])
         else:  # still images do not move: only the ranges themselves
             for name, allowed, unit, _d in MOTION_FIELDS:
-                _range(name, cfg["motion"][name], allowed, unit)
+                as_range(name, cfg["motion"][name], allowed, unit)
     except ValueError as e:
         raise ValueError(f"config: motion.{e}") from None
     sensor = config.get("sensor", {})
