@@ -131,7 +131,7 @@ def test_augmentation_builds_scenes_and_composites_on_one_thread(two_threads, mo
     from roughsea_torch import parameter_render as R
 
     seen = {"scene": [], "finish": []}
-    finish, scene_init = A._Seas._finish, R.SeaScene.__init__
+    finish, scene_init = A.RandomSeaBase._finish, R.SeaScene.__init__
 
     def spy_finish(self, *a, **k):
         seen["finish"].append(torch.get_num_threads())
@@ -150,7 +150,7 @@ def test_augmentation_builds_scenes_and_composites_on_one_thread(two_threads, mo
         seen["camera"].append(torch.get_num_threads())
         return make_camera(*a, **k)
 
-    monkeypatch.setattr(A._Seas, "_finish", spy_finish)
+    monkeypatch.setattr(A.RandomSeaBase, "_finish", spy_finish)
     monkeypatch.setattr(R.SeaScene, "__init__", spy_scene)
     monkeypatch.setattr(R, "make_camera", spy_camera)
     aug = rs.RandomSeaBackground(texture=False, output="brightness_temperature")
