@@ -104,7 +104,7 @@ def _frame_jobs(scene: SeaScene, params: dict[str, torch.Tensor], frames: dict[s
     pose = {name: _take(frames, name, idx, dtype, device) for name in ("pitch_deg", "roll_deg", "altitude_m")}
     # the wave time stays float64 (TextureTable's phases ω t): float32 rounds 1e5 s to 1/128 s
     pose["time_s"] = frames["time_s"][idx.to(frames["time_s"].device)].to(dtype=torch.float64, device=device)
-    cam = dict(hfov_deg=_take(params, "hfov_deg", idx, dtype, device), yaw_deg=_take(params, "yaw_deg", idx, dtype, device))
+    cam = {name: _take(params, name, idx, dtype, device) for name in ("hfov_deg", "yaw_deg")}
     jobs = []
     for t in range(frames["time_s"].shape[1]):
         frame_scene = scene
@@ -113,7 +113,8 @@ def _frame_jobs(scene: SeaScene, params: dict[str, torch.Tensor], frames: dict[s
             frame_scene.time_s = pose["time_s"][:, t]
         cam_t = dict(cam, altitude_m=pose["altitude_m"][:, t], pitch_deg=pose["pitch_deg"][:, t],
                      roll_deg=pose["roll_deg"][:, t])
-        jobs.append(_FrameJob(idx, t, cam_t, frame_scene, not textured and idx.numel() <= images_per_chunk(frame_scene)))
+        one_chunk = not textured and idx.numel() <= images_per_chunk(frame_scene)
+        jobs.append(_FrameJob(idx, t, cam_t, frame_scene, one_chunk))
     return jobs
 
 

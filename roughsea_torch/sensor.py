@@ -42,7 +42,12 @@ from ._parallel import one_thread
 from ._sensor_common import check_image, check_int, check_pair, round_ste
 from ._validation import check_finite_range, per_batch
 from .radiometry import LWIR, as_band, band_radiance
-from .sensor_noise import DetectorNoise, FixedPatternNoise, detector_noise, noise_equivalent_radiance  # noqa: F401  (re-exported)
+from .sensor_noise import (  # noqa: F401  (detector_noise, noise_equivalent_radiance: re-exported)
+    DetectorNoise,
+    FixedPatternNoise,
+    detector_noise,
+    noise_equivalent_radiance,
+)
 
 __all__ = [
     "optics_blur",
