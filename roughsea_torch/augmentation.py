@@ -51,7 +51,7 @@ from .geometry import EARTH_RADIUS_M
 from .parameter_render import CALM_WIND_SPEED, render_clip_parameters, render_frames, render_parameters
 from .radiometry import LWIR, as_band, band_radiance, brightness_temperature
 from .render import TableSize, check_foam
-from .sampling import (  # noqa: F401  (DEFAULT_TIME_S, TIME_RANGE_S, image_seed: importable from here, as before)
+from .sampling import (  # noqa: F401  (re-exported: users import these names from here)
     DEFAULT_TIME_S,
     MOTION_FIELDS,
     SCENE_FIELDS,

@@ -325,7 +325,7 @@ class SceneSampler:
             for i, name in enumerate(MOTION_FIELD_NAMES):
                 out[name] = _uniform(self.motion[name], um[i])
             out["phase_rad"] = (2.0 * math.pi) * um[-1]
-        if self.daytime > 0.0:  # last: with daytime 0 nothing is drawn, and the draws above are as before
+        if self.daytime > 0.0:  # last: with daytime 0 nothing is drawn, and the draws above do not depend on it
             us = torch.rand(3, n, generator=generator, dtype=torch.float64)
             out["is_day"] = us[0] < self.daytime
             out["sun_elevation_deg"] = _uniform(self.sun_ranges["sun_elevation_deg"], us[1])
