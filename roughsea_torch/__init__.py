@@ -45,7 +45,7 @@ from .augmentation import RandomSeaBackground, RandomSeaClip, SceneSampler
 from .dataset import SeaShardDataset
 from .sensor import SensorModel
 
-__version__ = "0.1.0"
+from ._version import __version__  # noqa: E402
 
 __all__ = [
     "atmosphere",

@@ -1,5 +1,7 @@
-"""Sea-background datasets on disk: a validated config, a sharded generator that resumes and scales
-out, and a ``torch.utils.data`` dataset that streams the shards back.
+"""Sea-background datasets on disk: a sharded generator that resumes and scales out, and a
+``torch.utils.data`` dataset that streams the shards back. The config they take (its defaults,
+:func:`resolve_config`, :func:`build_sensor`) is :mod:`roughsea_torch.dataset_config`'s, importable
+from here too.
 
 Layout of an output directory::
 
@@ -26,15 +28,15 @@ pose, textured (``scene.texture = true``, the default: one wave seed and a time 
 the expectation image (``false``). ``clip_length = T > 1`` makes clips: one sea realization per
 clip, frame t at ``time_s`` + t / ``frame_rate`` [s], seen from a camera on a
 :class:`~roughsea_torch.motion.PlatformMotion` whose amplitudes and periods are drawn per clip
-from the ``[motion]`` ranges (:data:`~roughsea_torch.augmentation.MOTION_FIELDS`). Every frame is
-re-rendered exactly by :func:`~roughsea_torch.augmentation.render_parameters` of its item's fields
+from the ``[motion]`` ranges (:data:`~roughsea_torch.sampling.MOTION_FIELDS`). Every frame is
+re-rendered exactly by :func:`~roughsea_torch.parameter_render.render_parameters` of its item's fields
 with ``pitch_deg``, ``roll_deg``, ``altitude_m``, ``time_s`` replaced by the frame's, and its
 sensor noise drawn from ``frame_noise_seed`` (with the config's ``scene.band``, ``anisotropic``,
 ``path`` and ``foam``; ``foam = false`` leaves the whitecaps out, ``"auto"`` is the default).
 
 Determinism: item i (image or clip) is made only from (seed, i) (its parameters, wave seed,
 motion and noise streams come from
-:func:`~roughsea_torch.augmentation.SceneSampler.sample_indexed`), and shard k always holds
+:func:`~roughsea_torch.sampling.SceneSampler.sample_indexed`), and shard k always holds
 items [k·S, (k+1)·S) rendered together, so a shard's bytes do not depend on how many workers,
 ranks or restarts made it. Writes go to a temporary name and are renamed into place (atomic on
 POSIX), so a killed run leaves whole shards or none; a restart makes only the missing ones.
@@ -42,9 +44,8 @@ POSIX), so a killed run leaves whole shards or none; a restart makes only the mi
 
 from __future__ import annotations
 
-import copy
 import hashlib
-import inspect
+import io
 import json
 import math
 import os
@@ -54,211 +55,23 @@ from typing import Any, Callable, Iterator
 import numpy as np
 import torch
 
-from .augmentation import (
-    DEFAULT_TIME_S,
-    MOTION_FIELDS,
-    SCENE_FIELDS,
-    SUN_FIELDS,
-    SceneSampler,
-    _range,
-    frame_parameters,
-    image_seed,
-    render_clip_parameters,
-    render_parameters,
-)
-from .radiometry import LWIR, MWIR, SpectralBand, as_band
-from .renderer import check_foam
+from ._version import __version__
+from .dataset_config import DEFAULT_CONFIG, build_sensor, config_band, config_sampler, resolve_config
+from .parameter_render import render_clip_parameters, render_parameters
+from .sampling import MOTION_FIELDS, SCENE_FIELDS, frame_parameters, image_seed
 
 __all__ = ["DEFAULT_CONFIG", "resolve_config", "build_sensor", "generate", "SeaShardDataset", "shard_name",
            "frame_render_parameters"]
-
-DEFAULT_CONFIG: dict[str, Any] = {
-    "seed": 0,
-    "num_images": 64,
-    "shard_size": 16,
-    "batch_size": 4,
-    "dtype": "float32",
-    "clip_length": 1,
-    "frame_rate": 25.0,
-    "camera": {"height": 512, "width": 640},
-    "scene": {"atmospheres": ["midlatitude_summer"], "band": "LWIR", "anisotropic": True, "path": True,
-              "foam": "auto", "texture": True, "time_s": list(DEFAULT_TIME_S),
-              "daytime": 0.0, **{name: list(d) for name, _a, _u, d in SUN_FIELDS}, "sun_azimuth_relative_to_yaw": True,
-              **{name: (list(d) if isinstance(d, tuple) else d) for name, _a, _u, d in SCENE_FIELDS}},
-    "motion": {name: list(d) for name, _a, _u, d in MOTION_FIELDS},
-    "sensor": {
-        "blur": {"sigma_px": 0.7},
-        "noise": {"netd_k": 0.05},
-        "fixed_pattern": {"seed": 0},
-        "counts": {"bits": 14, "temperature_range": [220.0, 340.0]},
-    },
-}
-_BANDS = {"LWIR": LWIR, "MWIR": MWIR}
-_SENSOR_STAGES = ("blur", "noise", "fixed_pattern", "counts")
 
 
 def shard_name(k: int) -> str:
     return f"shard_{k:06d}.npz"
 
 
-def _band(name: Any) -> SpectralBand:
-    if isinstance(name, str) and name in _BANDS:
-        return as_band(_BANDS[name])
-    if isinstance(name, (list, tuple)) and len(name) == 2:
-        return as_band((float(name[0]), float(name[1])))
-    raise ValueError(f"scene.band: 'LWIR', 'MWIR' or [lambda_lo_m, lambda_hi_m]; got {name!r}")
-
-
-def _sampler(scene: dict[str, Any], motion: dict[str, Any] | None = None) -> SceneSampler:
-    """The SceneSampler of a config's ``scene`` table (its ranges, checked against the path tables
-    when ``path`` is on; ``anisotropic`` aside), with the ``motion`` ranges for clips."""
-    return SceneSampler(band=_band(scene["band"]), motion=motion,
-                        **{k: (tuple(v) if isinstance(v, list) else v) for k, v in scene.items()
-                           if k not in ("band", "anisotropic", "foam")})
-
-
-def _config_sampler(cfg: dict[str, Any]) -> SceneSampler:
-    """The sampler of a resolved config: with motion when it makes clips."""
-    return _sampler(cfg["scene"], cfg["motion"] if cfg["clip_length"] > 1 else None)
-
-
-def _stage_classes() -> dict[str, type]:
-    from . import sensor as S
-
-    return {"blur": S.OpticsBlur, "noise": S.DetectorNoise, "fixed_pattern": S.FixedPatternNoise, "counts": S.ToCounts}
-
-
-def _check_keys(where: str, given: dict[str, Any], allowed: set[str]) -> None:
-    unknown = sorted(set(given) - allowed)
-    if unknown:
-        raise ValueError(f"config: unknown key(s) {', '.join(f'{where}{k}' for k in unknown)}; allowed in "
-                         f"{where.rstrip('.') or 'the top level'}: {sorted(allowed)}")
-
-
-def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
-    """Check a config (e.g. read from TOML) and fill in the defaults of :data:`DEFAULT_CONFIG`.
-
-    Every key is checked before any work starts: unknown keys, empty or inverted ranges,
-    impossible poses (a camera at or below the sea), bad sizes raise ``ValueError`` naming the
-    key. A sensor stage is left out by omitting its table or setting it to ``false``; the
-    ``counts`` stage is required (shards hold 16-bit counts).
-
-    Keys beyond the scene ranges: ``scene.texture`` (bool, default true: textured seas, one wave
-    seed and one time per item; false: the expectation image), ``scene.time_s`` (range of the
-    realizations' times [s], default [0, 3600)), ``clip_length`` (frames per item, integer ≥ 1;
-    default 1: still images), ``frame_rate`` ([Hz], > 0, default 25; used by clips), and the
-    ``motion`` table (ranges of the platform's oscillations for clips, keys of
-    :data:`~roughsea_torch.augmentation.MOTION_FIELDS`: amplitudes [deg], [m], periods [s]).
-    Day images: ``scene.daytime`` (probability in [0, 1] that an item is by day, default 0.0: all
-    by night, shards as before), ``scene.sun_elevation_deg`` (range [deg] within [0, 90], default
-    [2, 60]), ``scene.sun_azimuth_deg`` (range [deg], default [-180, 180]; relative to the camera's
-    yaw, 0 straight ahead, unless ``scene.sun_azimuth_relative_to_yaw = false``: world azimuth);
-    see :class:`~roughsea_torch.augmentation.SceneSampler`.
-    """
-    if not isinstance(config, dict):
-        raise ValueError("config must be a table/dict")
-    _check_keys("", config, set(DEFAULT_CONFIG))
-    cfg = copy.deepcopy(DEFAULT_CONFIG)
-    for key in ("seed", "num_images", "shard_size", "batch_size", "dtype", "clip_length", "frame_rate"):
-        if key in config:
-            cfg[key] = config[key]
-    for key, lo in (("seed", 0), ("num_images", 1), ("shard_size", 1), ("batch_size", 1), ("clip_length", 1)):
-        v = cfg[key]
-        if not isinstance(v, int) or isinstance(v, bool) or v < lo:
-            raise ValueError(f"config: {key} must be an integer >= {lo}; got {v!r}")
-    fr = cfg["frame_rate"]
-    if not isinstance(fr, (int, float)) or isinstance(fr, bool) or not (math.isfinite(fr) and fr > 0):
-        raise ValueError(f"config: frame_rate must be a number > 0 [Hz]; got {fr!r}")
-    cfg["frame_rate"] = float(fr)
-    if cfg["dtype"] not in ("float32", "float64"):
-        raise ValueError(f"config: dtype must be 'float32' or 'float64'; got {cfg['dtype']!r}")
-    cam = config.get("camera", {})
-    _check_keys("camera.", cam, set(DEFAULT_CONFIG["camera"]))
-    cfg["camera"].update(cam)
-    for key in ("height", "width"):
-        v = cfg["camera"][key]
-        if not isinstance(v, int) or isinstance(v, bool) or not 1 <= v <= 8192:
-            raise ValueError(f"config: camera.{key} must be an integer in [1, 8192]; got {v!r}")
-    scene = config.get("scene", {})
-    _check_keys("scene.", scene, set(DEFAULT_CONFIG["scene"]))
-    cfg["scene"].update(scene)
-    sc = cfg["scene"]
-    _band(sc["band"])
-    for key in ("anisotropic", "path", "texture", "sun_azimuth_relative_to_yaw"):
-        if not isinstance(sc[key], bool):
-            raise ValueError(f"config: scene.{key} must be true or false; got {sc[key]!r}")
-    try:
-        check_foam(sc["foam"], per_image=False)  # "auto", false or one fraction (true: refused, pointing at "auto")
-    except ValueError as e:
-        raise ValueError(f"config: scene.{e}") from None
-    try:
-        _sampler(sc)
-    except ValueError as e:
-        raise ValueError(f"config: scene.{e}") from None
-    motion = config.get("motion", {})
-    if not isinstance(motion, dict):
-        raise ValueError(f"config: motion must be a table of ranges; got {motion!r}")
-    _check_keys("motion.", motion, set(DEFAULT_CONFIG["motion"]))
-    cfg["motion"].update(motion)
-    try:
-        if cfg["clip_length"] > 1:  # the ranges, and the pose ± amplitudes against the allowed poses
-            _sampler(sc, cfg["motion"])
-        else:  # still images do not move: only the ranges themselves
-            for name, allowed, unit, _d in MOTION_FIELDS:
-                _range(name, cfg["motion"][name], allowed, unit)
-    except ValueError as e:
-        raise ValueError(f"config: motion.{e}") from None
-    sensor = config.get("sensor", {})
-    _check_keys("sensor.", sensor, set(_SENSOR_STAGES))
-    for stage in _SENSOR_STAGES:
-        if stage in sensor:
-            v = sensor[stage]
-            cfg["sensor"][stage] = False if v is False else dict(v) if isinstance(v, dict) else v
-        if cfg["sensor"][stage] is not False and not isinstance(cfg["sensor"][stage], dict):
-            raise ValueError(f"config: sensor.{stage} must be a table of settings or false; got {cfg['sensor'][stage]!r}")
-    if cfg["sensor"]["counts"] is False:
-        raise ValueError("config: sensor.counts is required (the shards hold 16-bit counts)")
-    bits = cfg["sensor"]["counts"].get("bits", 14)
-    if not isinstance(bits, int) or not 1 <= bits <= 16:
-        raise ValueError(f"config: sensor.counts.bits must be an integer in [1, 16] (16-bit shards); got {bits!r}")
-    classes = _stage_classes()
-    for stage, cls in classes.items():
-        settings = cfg["sensor"][stage]
-        if settings is False:
-            continue
-        params = inspect.signature(cls.__init__).parameters
-        _check_keys(f"sensor.{stage}.", settings, {p for p in params if p not in ("self", "band")})
-    build_sensor(cfg)  # the stages' own range checks, before any work
-    return cfg
-
-
-def build_sensor(cfg: dict[str, Any]) -> torch.nn.Module:
-    """The ``SensorModel`` of a resolved config (stages set to ``false`` are left out)."""
-    from .sensor import SensorModel
-
-    band = _band(cfg["scene"]["band"])
-    stages: dict[str, Any] = {}
-    for stage, cls in _stage_classes().items():
-        settings = cfg["sensor"][stage]
-        if settings is False:
-            stages[stage] = None
-            continue
-        kw = {k: (tuple(v) if isinstance(v, list) else v) for k, v in settings.items()}
-        if "band" in inspect.signature(cls.__init__).parameters:
-            kw["band"] = band
-        try:
-            stages[stage] = cls(**kw)
-        except ValueError as e:
-            raise ValueError(f"config: sensor.{stage}: {e}") from None
-    return SensorModel(**stages)
-
-
 def _atomic_write(path: Path, write: Callable[[Any], None], crash_after_bytes: int | None = None) -> None:
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
     with open(tmp, "wb") as f:
         if crash_after_bytes is not None:  # testing hook: die in the middle of a write
-            import io
-
             buf = io.BytesIO()
             write(buf)
             f.write(buf.getvalue()[:crash_after_bytes])
@@ -279,7 +92,7 @@ def render_shard(cfg: dict[str, Any], k: int, sensor: torch.nn.Module | None = N
     """Items [k·S, (k+1)·S) of a resolved config: counts (uint16; (N, H, W), or (N, T, H, W) for
     clips) and their parameters."""
     sc = cfg["scene"]
-    sampler = _config_sampler(cfg)
+    sampler = config_sampler(cfg)
     S, N = cfg["shard_size"], cfg["num_images"]
     T = cfg["clip_length"]
     indices = list(range(k * S, min((k + 1) * S, N)))
@@ -294,8 +107,8 @@ def render_shard(cfg: dict[str, Any], k: int, sensor: torch.nn.Module | None = N
     with torch.no_grad():
         for i in range(0, len(indices), bs):
             sub = {n: v[i : i + bs] for n, v in params.items()}
-            kw = dict(band=_band(sc["band"]), anisotropic=sc["anisotropic"], dtype=dtype, device=device, path=sc["path"],
-                      foam=sc["foam"])
+            kw = dict(band=config_band(sc["band"]), anisotropic=sc["anisotropic"], dtype=dtype, device=device,
+                      path=sc["path"], foam=sc["foam"])
             if T > 1:
                 L = render_clip_parameters(sub, T, cfg["frame_rate"], H, W, sampler.atmospheres, **kw)
                 seeds = frames["noise_seed"][i : i + bs]
@@ -315,10 +128,10 @@ def render_shard(cfg: dict[str, Any], k: int, sensor: torch.nn.Module | None = N
     out["atmosphere"] = np.asarray([sampler.atmospheres[a] for a in params["atmosphere"].tolist()])
     out["noise_seed"] = params["noise_seed"].numpy()
     out["image_seed"] = np.asarray([image_seed(cfg["seed"], i) for i in indices], dtype=np.uint64)
-    for name in ("wave_seed", "time_s"):  # texture on (absent otherwise: such shards are as before texture)
+    for name in ("wave_seed", "time_s"):  # texture on (absent otherwise)
         if name in params:
             out[name] = params[name].numpy()
-    if "is_day" in params:  # daytime > 0 (absent otherwise: such shards are as before the sun)
+    if "is_day" in params:  # daytime > 0 (absent otherwise)
         out["is_day"] = params["is_day"].numpy()
         out["sun_elevation_deg"] = params["sun_elevation_deg"].numpy()
         out["sun_zenith_deg"] = (90.0 - params["sun_elevation_deg"]).numpy()
@@ -333,7 +146,7 @@ def render_shard(cfg: dict[str, Any], k: int, sensor: torch.nn.Module | None = N
 
 
 def frame_render_parameters(meta: dict[str, Any], frame: int | None = None) -> dict[str, torch.Tensor]:
-    """The :func:`~roughsea_torch.augmentation.render_parameters` input (one image) of an item's
+    """The :func:`~roughsea_torch.parameter_render.render_parameters` input (one image) of an item's
     metadata (as :class:`SeaShardDataset` yields it, or a shard's arrays at one index), for a
     still image or, with ``frame``, frame ``frame`` of a clip: its pose and time replaced by the
     frame's.
@@ -401,9 +214,7 @@ def num_shards(cfg: dict[str, Any]) -> int:
 
 
 def _metadata(cfg: dict[str, Any]) -> dict[str, Any]:
-    from . import __version__
-
-    band = _band(cfg["scene"]["band"])
+    band = config_band(cfg["scene"]["band"])
     return {"config": cfg, "band_m": [band.lo, band.hi], "roughsea_torch": __version__,
             "torch": torch.__version__.split("+")[0], "num_shards": num_shards(cfg),
             "units": {"images": "sensor counts (uint16); see sensor.counts for the radiance mapping",
@@ -411,6 +222,48 @@ def _metadata(cfg: dict[str, Any]) -> dict[str, Any]:
                       "time_s": "s", "frame_rate": "Hz", "heave_amplitude_m": "m", "periods": "s",
                       "phase_rad": "rad", "sun_elevation_deg": "deg above the horizon",
                       "sun_zenith_deg": "deg", "sun_azimuth_deg": "deg, world azimuth (from +x towards +y, as yaw_deg)"}}
+
+
+def _open_run(out: Path, meta: dict[str, Any], rank: int, world_size: int) -> None:
+    """Start or resume the run in ``out``: write its ``config.json`` (metadata ``meta``), or check that
+    the one there is the same (``ValueError`` otherwise); remove the pieces of this rank's writes
+    that a killed run left behind."""
+    cfg_path = out / "config.json"
+    if cfg_path.exists():
+        old = json.loads(cfg_path.read_text())
+        if old != json.loads(json.dumps(meta)):
+            raise ValueError(f"out: {out} holds a run with another config (or library version); "
+                             "resume with the same config or use another directory")
+    else:
+        _write_json(cfg_path, meta)
+    for tmp in out.glob(".shard_*.tmp*"):  # pieces of writes a killed run left behind
+        k = int(tmp.name.split("_")[1].split(".")[0])
+        if k % world_size == rank:
+            tmp.unlink(missing_ok=True)
+
+
+def _finished_shards(out: Path, mine: list[int], manifest_path: Path) -> dict[int, dict[str, Any]]:
+    """The manifest entries of the shards of ``mine`` already in ``out``: those of this rank's
+    manifest whose file exists, and those renamed into place before the manifest was rewritten."""
+    done: dict[int, dict[str, Any]] = {}
+    if manifest_path.exists():
+        for e in json.loads(manifest_path.read_text())["shards"]:
+            if (out / e["file"]).exists():
+                done[e["shard"]] = e
+    for k in mine:  # a shard renamed into place but not yet in the manifest when the run died
+        if k not in done and (out / shard_name(k)).exists():
+            with np.load(out / shard_name(k)) as z:
+                n = int(z["images"].shape[0])
+            done[k] = {"shard": k, "file": shard_name(k), "images": n, "sha256": _sha256(out / shard_name(k))}
+    return done
+
+
+def _progress_bar(cfg: dict[str, Any], todo: list[int], rank: int) -> Any:
+    """A tqdm bar over the items of the shards ``todo``."""
+    from tqdm import tqdm  # an optional dependency (the "test" and "pipelines" extras): imported when used
+
+    return tqdm(total=sum(min(cfg["shard_size"], cfg["num_images"] - k * cfg["shard_size"]) for k in todo),
+                unit="img" if cfg["clip_length"] == 1 else "clip", desc=f"rank {rank} shards", dynamic_ncols=True)
 
 
 def generate(
@@ -449,43 +302,17 @@ def generate(
         raise ValueError(f"workers must be an int >= 0; got {workers!r}")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    meta = _metadata(cfg)
-    cfg_path = out / "config.json"
-    if cfg_path.exists():
-        old = json.loads(cfg_path.read_text())
-        if old != json.loads(json.dumps(meta)):
-            raise ValueError(f"out: {out} holds a run with another config (or library version); "
-                             "resume with the same config or use another directory")
-    else:
-        _write_json(cfg_path, meta)
-    for tmp in out.glob(".shard_*.tmp*"):  # pieces of writes a killed run left behind
-        k = int(tmp.name.split("_")[1].split(".")[0])
-        if k % world_size == rank:
-            tmp.unlink(missing_ok=True)
+    _open_run(out, _metadata(cfg), rank, world_size)
     mine = [k for k in range(num_shards(cfg)) if k % world_size == rank]
     manifest_path = out / f"manifest_rank{rank:03d}.json"
-    done: dict[int, dict[str, Any]] = {}
-    if manifest_path.exists():
-        for e in json.loads(manifest_path.read_text())["shards"]:
-            if (out / e["file"]).exists():
-                done[e["shard"]] = e
-    for k in mine:  # a shard renamed into place but not yet in the manifest when the run died
-        if k not in done and (out / shard_name(k)).exists():
-            with np.load(out / shard_name(k)) as z:
-                n = int(z["images"].shape[0])
-            done[k] = {"shard": k, "file": shard_name(k), "images": n, "sha256": _sha256(out / shard_name(k))}
+    done = _finished_shards(out, mine, manifest_path)
     todo = [k for k in mine if k not in done]
     manifest = {"rank": rank, "world_size": world_size, "shards": [done[k] for k in sorted(done)]}
     if todo:
         jobs = _ShardJobs(cfg, out, todo, crash_after_shards)
         loader = torch.utils.data.DataLoader(jobs, batch_size=None, num_workers=workers, shuffle=False,
                                              persistent_workers=False)
-        bar = None
-        if progress:
-            from tqdm import tqdm
-
-            bar = tqdm(total=sum(min(cfg["shard_size"], cfg["num_images"] - k * cfg["shard_size"]) for k in todo),
-                       unit="img" if cfg["clip_length"] == 1 else "clip", desc=f"rank {rank} shards", dynamic_ncols=True)
+        bar = _progress_bar(cfg, todo, rank) if progress else None
         for entry in loader:
             done[entry["shard"]] = entry
             manifest["shards"] = [done[k] for k in sorted(done)]

@@ -122,7 +122,7 @@ def render_clip(
         start_s: the sea's time at ``times_s`` = 0 (float or (B,), e.g. a different start per
             image): frame t shows the sea at ``start_s + times_s[t]``; default the scene's ``time_s``.
         progress: a tqdm progress bar over the frames.
-        **render_kwargs: passed to :func:`~roughsea_torch.render` (``output=`` ...).
+        **render_kwargs: passed to :func:`~roughsea_torch.renderer.render` (``output=`` ...).
 
     Returns:
         (B, T, 1, H, W), kornia's video layout (``VideoSequential(data_format="BTCHW")``).
@@ -145,7 +145,7 @@ def render_clip(
     frames = []
     it = times.tolist()
     if progress:
-        from tqdm.auto import tqdm
+        from tqdm.auto import tqdm  # an optional dependency: imported when a progress bar is asked for
 
         it = tqdm(it, desc="frames", unit="frame")
     for t in it:

@@ -28,6 +28,7 @@ __all__ = [
     "MWIR",
     "SpectralBand",
     "planck_radiance",
+    "planck_radiance_derivative",
     "band_radiance",
     "brightness_temperature",
     "band_radiance_slope",
@@ -69,8 +70,18 @@ def _planck(lam: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
     return (_C1 * 1e24 * 1e6) * torch.exp(-x) / (lam_um**5 * -torch.expm1(-x))
 
 
-def _planck_dT(lam: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
-    """∂B_λ/∂T = B_λ · x / (T (1 − e^{−x})) [W m⁻² sr⁻¹ m⁻¹ K⁻¹]; 0 (not NaN) where B_λ underflows."""
+def planck_radiance_derivative(lam: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
+    """Temperature derivative of the blackbody spectral radiance, ∂B_λ/∂T [W m⁻² sr⁻¹ m⁻¹ K⁻¹].
+
+    Args:
+        lam: wavelength λ [m] > 0, a tensor.
+        t: temperature T [K] > 0, a tensor of the same dtype and device, broadcastable with ``lam``.
+
+    ∂B_λ/∂T = B_λ · x / (T (1 − e^{−x})) with x = h c / (λ k T); 0 (not NaN) where B_λ underflows.
+    Summed with a band's quadrature weights (``SpectralBand.nodes``) it gives dL/dT of
+    :func:`band_radiance`. The inputs are not checked (it runs inside band sums); see
+    :func:`planck_radiance` for B_λ itself on checked inputs.
+    """
     lam_um = lam * 1e6
     x = (_C2 * 1e6) / (lam_um * t)
     return _planck(lam, t) * x / (t * -torch.expm1(-x))
@@ -321,7 +332,7 @@ def _bt_table(band: SpectralBand, dtype: torch.dtype, device: torch.device) -> t
         lam, w = (torch.as_tensor(a, dtype=torch.float64) for a in band.quadrature)
         T = torch.arange(_T_LO, _T_HI + _T_STEP / 2, _T_STEP, dtype=torch.float64)
         L = (_planck(lam, T[:, None]) * w).sum(-1)
-        m = 1.0 / (_planck_dT(lam, T[:, None]) * w).sum(-1)  # dT/dL at the nodes
+        m = 1.0 / (planck_radiance_derivative(lam, T[:, None]) * w).sum(-1)  # dT/dL at the nodes
         h = L[1:] - L[:-1]
         dT = T[1:] - T[:-1]
         c1 = h * m[:-1]
@@ -428,7 +439,8 @@ def band_radiance_slope(radiance: Any, band: Any = LWIR, response: Any = None) -
     if inside is not None:
         lam, w = b.nodes(dtype, device)
         T = brightness_temperature(L, b)
-        out = torch.where(inside.reshape(L.shape), out, (_planck_dT(lam, T.unsqueeze(-1)) * w).sum(-1))
+        exact = (planck_radiance_derivative(lam, T.unsqueeze(-1)) * w).sum(-1)
+        out = torch.where(inside.reshape(L.shape), out, exact)
     return out
 
 

@@ -470,3 +470,24 @@ def test_texture_off_wins_over_a_replayed_textured_draw():
     assert not torch.equal(v_off, v_tex)
     assert torch.equal(v_off, rs.RandomSeaClip(texture=False, **clip_kw)(v, params={k: w for k, w in clip._params.items()
                                                                                    if k != "wave_seed"}))
+
+
+def test_constructors_list_their_arguments():
+    """RandomSeaBackground and RandomSeaClip take the shared arguments (RandomSeaBase._set_up's, one
+    default each) through **shared, and inspect.signature still lists every argument in the order of
+    the keyword-only constructors they had; an unknown keyword is Python's own TypeError."""
+    import inspect
+
+    from roughsea_torch.augmentation import MOTION_FIELDS, RandomSeaBase, RandomSeaClip
+
+    shared = {n: q for n, q in inspect.signature(RandomSeaBase._set_up).parameters.items() if q.kind is q.KEYWORD_ONLY}
+    still = inspect.signature(RandomSeaBackground).parameters
+    clip = inspect.signature(RandomSeaClip).parameters
+    assert list(still) == [*shared, "p", "same_on_batch", "keepdim"]
+    assert list(clip) == ["frame_rate", "data_format", *(f[0] for f in MOTION_FIELDS), *shared, "p", "same_on_batch"]
+    assert all(q.kind is q.KEYWORD_ONLY for q in (*still.values(), *clip.values()))
+    assert all(still[n].default == q.default and clip[n].default == q.default for n, q in shared.items())
+    assert still["texture"].default is True and clip["wind_speed"].default == (1.0, 15.0)
+    for cls in (RandomSeaBackground, RandomSeaClip):
+        with pytest.raises(TypeError, match=rf"^{cls.__name__}\.__init__\(\) got an unexpected keyword argument 'wind'$"):
+            cls(wind=3.0, p=0.5)

@@ -16,7 +16,7 @@ import torch
 
 import roughsea_torch as rs
 from roughsea_torch import radiometry
-from roughsea_torch.radiometry import _BrightnessTemperature, _planck_dT, as_band
+from roughsea_torch.radiometry import _BrightnessTemperature, as_band, planck_radiance_derivative
 
 F64 = torch.float64
 BANDS = [(8e-6, 12e-6), (3e-6, 5e-6)]
@@ -29,7 +29,7 @@ def newton_bt(L: torch.Tensor, band) -> torch.Tensor:
 
 def band_sum_slope(T: torch.Tensor, band) -> torch.Tensor:
     lam, w = as_band(band).nodes(F64, T.device)
-    return (_planck_dT(lam, T.double().unsqueeze(-1)) * w).sum(-1)
+    return (planck_radiance_derivative(lam, T.double().unsqueeze(-1)) * w).sum(-1)
 
 
 @pytest.mark.parametrize("band", BANDS, ids=["LWIR", "MWIR"])

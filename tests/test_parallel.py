@@ -128,9 +128,10 @@ def test_augmentation_builds_scenes_and_composites_on_one_thread(two_threads, mo
     """RandomSeaBackground and RandomSeaClip build their scenes and cameras and composite (with the
     sensor) on one intra-op thread, and restore the caller's setting (also when a stage raises)."""
     from roughsea_torch import augmentation as A
+    from roughsea_torch import parameter_render as R
 
     seen = {"scene": [], "finish": []}
-    finish, scene_init = A._Seas._finish, A.SeaScene.__init__
+    finish, scene_init = A.RandomSeaBase._finish, R.SeaScene.__init__
 
     def spy_finish(self, *a, **k):
         seen["finish"].append(torch.get_num_threads())
@@ -143,15 +144,15 @@ def test_augmentation_builds_scenes_and_composites_on_one_thread(two_threads, mo
         return scene_init(self, *a, **k)
 
     seen["camera"] = []
-    make_camera = A.make_camera
+    make_camera = R.make_camera
 
     def spy_camera(*a, **k):
         seen["camera"].append(torch.get_num_threads())
         return make_camera(*a, **k)
 
-    monkeypatch.setattr(A._Seas, "_finish", spy_finish)
-    monkeypatch.setattr(A.SeaScene, "__init__", spy_scene)
-    monkeypatch.setattr(A, "make_camera", spy_camera)
+    monkeypatch.setattr(A.RandomSeaBase, "_finish", spy_finish)
+    monkeypatch.setattr(R.SeaScene, "__init__", spy_scene)
+    monkeypatch.setattr(R, "make_camera", spy_camera)
     aug = rs.RandomSeaBackground(texture=False, output="brightness_temperature")
     aug(torch.zeros(2, 1, 12, 16), generator=torch.Generator().manual_seed(0))
     assert seen["finish"] == [1] and seen["scene"] and set(seen["scene"]) == {1} and set(seen["camera"]) == {1}
@@ -173,18 +174,19 @@ def test_atmosphere_groups_render_on_the_workers_and_match_one_thread(two_thread
     worker threads, with the same images as on one thread (bitwise); with a gradient wanted they
     run in turn on the calling thread, and the gradient matches one thread's."""
     from roughsea_torch import augmentation as A
+    from roughsea_torch import parameter_render as R
 
     s = rs.SceneSampler(atmospheres=["midlatitude_summer", "tropical", "us_standard"])
     p = s.sample(6, torch.Generator().manual_seed(3))
     p["atmosphere"] = torch.tensor([0, 1, 2, 0, 1, 2])
     where = []
-    render = A.render
+    render = R.render
 
     def spy(*a, **k):
         where.append(threading.current_thread().name)
         return render(*a, **k)
 
-    monkeypatch.setattr(A, "render", spy)
+    monkeypatch.setattr(R, "render", spy)
     two = A.render_parameters(p, 12, 16, s.atmospheres, dtype=torch.float64)
     assert len(where) == 3 and all(name.startswith("roughsea") for name in where)
     torch.set_num_threads(1)
