@@ -19,6 +19,7 @@ from .radiometry import LWIR, as_band, band_weights
 
 __all__ = [
     "split_refractive_index",
+    "fresnel_terms",
     "fresnel_reflectance",
     "fresnel_emissivity",
     "water_refractive_index",
@@ -58,7 +59,7 @@ def split_refractive_index(
     return as_tensor(n, dtype, device), as_tensor(k, dtype, device)
 
 
-def _fresnel_terms(c: torch.Tensor, n: torch.Tensor, k: torch.Tensor, emission: bool = False
+def fresnel_terms(c: torch.Tensor, n: torch.Tensor, k: torch.Tensor, emission: bool = False
                    ) -> tuple[torch.Tensor, torch.Tensor]:
     """(|r_s|², |r_p|²), or with ``emission`` (1 − |r_s|², 1 − |r_p|²), each from its own form.
 
@@ -119,7 +120,7 @@ def fresnel_reflectance(
     dtype, device = resolve_dtype_device(cos_incidence=cos_incidence, refractive_index=refractive_index)
     c = as_tensor(cos_incidence, dtype, device).abs()
     n, k = split_refractive_index(refractive_index, dtype, device)
-    rs, rp = _fresnel_terms(c, n, k)
+    rs, rp = fresnel_terms(c, n, k)
     if polarization == "s":
         return rs
     if polarization == "p":
@@ -133,7 +134,7 @@ def fresnel_emissivity(cos_incidence: Any, refractive_index: Any) -> torch.Tenso
     dtype, device = resolve_dtype_device(cos_incidence=cos_incidence, refractive_index=refractive_index)
     c = as_tensor(cos_incidence, dtype, device).abs()
     n, k = split_refractive_index(refractive_index, dtype, device)
-    es, ep = _fresnel_terms(c, n, k, emission=True)
+    es, ep = fresnel_terms(c, n, k, emission=True)
     return 0.5 * (es + ep)
 
 
@@ -224,7 +225,7 @@ def band_refractive_index(
     h = 1e-6
     for _ in range(12):
         def res(nn, kk):
-            rs, rp = _fresnel_terms(c, nn[..., None], kk[..., None])
+            rs, rp = fresnel_terms(c, nn[..., None], kk[..., None])
             return 0.5 * (rs + rp) - target
 
         r0 = res(n, k)
@@ -239,7 +240,7 @@ def band_refractive_index(
     # keep whichever of the fit and the plain average matches ρ̄ better at its worst angle (in the
     # MWIR the least-squares optimum wants k < 0, and the bounded fit loses to the average)
     def worst(nn, kk):
-        rs, rp = _fresnel_terms(c, nn[..., None], kk[..., None])
+        rs, rp = fresnel_terms(c, nn[..., None], kk[..., None])
         return (0.5 * (rs + rp) - target).abs().amax(-1)
 
     use_fit = worst(n, k) <= worst(avg.real, avg.imag)
@@ -268,5 +269,5 @@ def band_reflectance(
     lam, w = band_weights(b, temperature, dtype, device)
     m = water_refractive_index(lam, source)
     c = as_tensor(cos_incidence, dtype, device).abs().unsqueeze(-1)
-    rs, rp = _fresnel_terms(c, m.real.to(dtype), m.imag.to(dtype))
+    rs, rp = fresnel_terms(c, m.real.to(dtype), m.imag.to(dtype))
     return (0.5 * (rs + rp) * w).sum(-1)

@@ -37,6 +37,8 @@ import numpy as np
 import torch
 
 from ._validation import as_tensor, check_finite_range
+from .facets import denominator, facet_geometry, prepare_inputs
+from .optics import fresnel_terms, split_refractive_index
 
 __all__ = ["Sun", "SUN_RADIUS", "glint_radiance", "sun_masking_factor"]
 
@@ -203,12 +205,9 @@ def glint_radiance(view_zenith: Any, view_azimuth: Any, slopes: Any, refractive_
     Returns:
         R_glint, the broadcast shape, the inputs' dtype and device; 0 for a sun below the horizon.
     """
-    from .expectation import _prepare
-    from .optics import split_refractive_index
-
-    dtype, device, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes, refractive_index,
-                                                          sun_zenith=sun.zenith, sun_azimuth=sun.azimuth,
-                                                          sun_irradiance=sun.irradiance)
+    dtype, device, vz, va, vx, vy, cxy, mx, my = prepare_inputs(view_zenith, view_azimuth, slopes, refractive_index,
+                                                                sun_zenith=sun.zenith, sun_azimuth=sun.azimuth,
+                                                                sun_irradiance=sun.irradiance)
     n, k = split_refractive_index(refractive_index, dtype, device)
     tz, tp = as_tensor(sun.zenith, dtype, device), as_tensor(sun.azimuth, dtype, device)
     e_sun, alpha = as_tensor(sun.irradiance, dtype, device), as_tensor(sun.radius, dtype, device)
@@ -264,8 +263,6 @@ def _glint_sharp(ct: torch.Tensor, st: torch.Tensor, cva: torch.Tensor, sva: tor
     at the mean slope s* of the facets that mirror the sun; the part of the glint that is sharp in the
     view direction (the rest, L_sun / D, is smooth). Returns (P ρ t, whether the sun is above the
     horizon)."""
-    from .optics import _fresnel_terms
-
     cxw, cyw, k11, k12, k22, det_k, l11, l21, l22, above = _specular_ellipse(ct, st, cva, sva, vx, vy, cxy, mx, my,
                                                                              tz, tp, alpha)
     shape = torch.broadcast_shapes(cxw.shape, cyw.shape, k11.shape, k12.shape, k22.shape, det_k.shape)
@@ -282,7 +279,7 @@ def _glint_sharp(ct: torch.Tensor, st: torch.Tensor, cva: torch.Tensor, sva: tor
     s_y = my + l21 * zx + l22 * zy
     t_g = ct + st * (s_x * cva + s_y * sva)
     cos_omega = (t_g * torch.rsqrt(1.0 + s_x * s_x + s_y * s_y)).clamp(0.0, 1.0)
-    rs_, rp_ = _fresnel_terms(cos_omega, n, k)
+    rs_, rp_ = fresnel_terms(cos_omega, n, k)
     return 0.5 * (rs_ + rp_) * t_g * prob, above
 
 
@@ -293,13 +290,11 @@ def _glint(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tenso
     its own pixels, whose values need no second check): P ρ t L_sun / D (:func:`_glint_sharp`).
     With ``smooth``, only the smooth factor L_sun / D (0 for a sun below the horizon), which the
     renderer tabulates."""
-    from .expectation import _denominator, _geometry
-
     dtype, device = vz.dtype, vz.device
     zero = torch.zeros((), dtype=dtype, device=device)
     if mx is None:
         mx = my = zero
-    D = _denominator(_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
+    D = denominator(facet_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
     l_sun = e_sun / (4.0 * math.pi * torch.sin(0.5 * alpha) ** 2)  # Ω_sun = 2π(1 − cos α), without cancellation
     if smooth:
         return torch.where(torch.cos(tz) > 0, l_sun / D, zero)
@@ -315,12 +310,10 @@ def sun_masking_factor(slopes: Any, sun: Sun, dtype: torch.dtype = torch.float64
 
     A textured sea applies the G1 of the scene's total slope law to every pixel's glint (the resolved
     waves mask the sun too), so that its ensemble mean is the expectation's glint."""
-    from .expectation import _denominator, _geometry
-
     tz, tp = as_tensor(sun.zenith, dtype, device), as_tensor(sun.azimuth, dtype, device)
     vx, vy, cxy = slopes.tensors(dtype, device)
     mx, my = slopes.mean_tensors(dtype, device)
-    gs = _geometry(tz.clamp_max(math.pi / 2), tp, vx, vy, cxy, mx, my)
-    d_sun = _denominator(gs, True)
+    gs = facet_geometry(tz.clamp_max(math.pi / 2), tp, vx, vy, cxy, mx, my)
+    d_sun = denominator(gs, True)
     e_s = (gs.ct + gs.st * gs.mu).clamp_min(0.0)
     return (e_s / d_sun.clamp_min(torch.finfo(dtype).tiny)).clamp(0.0, 1.0)
