@@ -90,6 +90,7 @@ __all__ = [
     "with_foam",
     "CREST_FOAM_FLOOR",
     "crest_foam_fraction",
+    "crest_fraction_from_variances",
 ]
 
 MONAHAN_COEFFICIENT = 3.84e-6  # Monahan & O'Muircheartaigh 1980, W = a U10^b (fraction, U10 in m/s)
@@ -381,12 +382,14 @@ def crest_foam_fraction(
     v_r = as_tensor(resolved_variance, dtype, device)
     v_t = as_tensor(total_variance, dtype, device)
     w = as_tensor(whitecap_fraction, dtype, device)
-    return _crest_foam_fraction(x, v_r, v_t, w, floor)
+    return crest_fraction_from_variances(x, v_r, v_t, w, floor)
 
 
-def _crest_foam_fraction(x: torch.Tensor, v_r: torch.Tensor, v_t: torch.Tensor, w: torch.Tensor,
-                         floor: float = CREST_FOAM_FLOOR) -> torch.Tensor:
-    """:func:`crest_foam_fraction` on tensors already checked (the renderer's, per pixel)."""
+def crest_fraction_from_variances(x: torch.Tensor, v_r: torch.Tensor, v_t: torch.Tensor, w: torch.Tensor,
+                                  floor: float = CREST_FOAM_FLOOR) -> torch.Tensor:
+    """:func:`crest_foam_fraction` on tensors already checked (the renderer's, per pixel): the crest
+    variable X_r (``x``), its resolved and total variances σ_r², σ_X² (``v_r``, ``v_t``) and the
+    whitecap fraction W (``w``), of one dtype and device, broadcasting together."""
     v_u = torch.clamp(v_t - v_r, min=0.0) + (floor * floor) * v_t
     known = v_u > 0  # False only without crest variance at all (or ρ = 0 and nothing unresolved)
     v_u = torch.where(known, v_u, torch.ones_like(v_u))
@@ -398,3 +401,7 @@ def _crest_foam_fraction(x: torch.Tensor, v_r: torch.Tensor, v_t: torch.Tensor, 
     f = torch.where(w < _W_MIN, f * (w / _W_MIN), f)  # exactly 0 at W = 0, mean still W
     f = torch.where(known, f, w)
     return torch.where(inner, f, torch.ones_like(f))
+
+
+# TEMPORARY alias for render.py until the renderer moves; the lead removes it at merge.
+_crest_foam_fraction = crest_fraction_from_variances

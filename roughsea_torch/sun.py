@@ -40,7 +40,7 @@ from ._validation import as_tensor, check_finite_range
 from .facets import denominator, facet_geometry, prepare_inputs
 from .optics import fresnel_terms, split_refractive_index
 
-__all__ = ["Sun", "SUN_RADIUS", "glint_radiance", "sun_masking_factor"]
+__all__ = ["Sun", "SUN_RADIUS", "glint_radiance", "sun_masking_factor", "glint_from_moments", "glint_sharp_factor"]
 
 SUN_RADIUS = math.radians(0.2666)  # angular radius of the sun's disk at 1 AU [rad]
 _SQRT_HALF = math.sqrt(0.5)
@@ -211,7 +211,7 @@ def glint_radiance(view_zenith: Any, view_azimuth: Any, slopes: Any, refractive_
     n, k = split_refractive_index(refractive_index, dtype, device)
     tz, tp = as_tensor(sun.zenith, dtype, device), as_tensor(sun.azimuth, dtype, device)
     e_sun, alpha = as_tensor(sun.irradiance, dtype, device), as_tensor(sun.radius, dtype, device)
-    out = _glint(vz, va, vx, vy, cxy, mx, my, n, k, tz, tp, e_sun, alpha, shadowing)
+    out = glint_from_moments(vz, va, vx, vy, cxy, mx, my, n, k, tz, tp, e_sun, alpha, shadowing)
     if sun_masking:
         out = out * sun_masking_factor(slopes, sun, dtype, device)
     return out
@@ -255,14 +255,27 @@ def _specular_ellipse(ct: torch.Tensor, st: torch.Tensor, cph: torch.Tensor, sph
     return cxw, cyw, k11, k12, k22, det_k, l11, l21, l22, above
 
 
-def _glint_sharp(ct: torch.Tensor, st: torch.Tensor, cva: torch.Tensor, sva: torch.Tensor, vx: torch.Tensor,
-                 vy: torch.Tensor, cxy: torch.Tensor, mx: torch.Tensor, my: torch.Tensor, n: torch.Tensor, k: torch.Tensor,
-                 tz: torch.Tensor, tp: torch.Tensor, alpha: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-    """P ρ t of the glint (module docstring) for lines of sight of cos/sin θ̂ and cos/sin φ̂: the
-    Gaussian probability P of the sun's ellipse in slope space, and the Fresnel ρ and facet cosine t
-    at the mean slope s* of the facets that mirror the sun; the part of the glint that is sharp in the
-    view direction (the rest, L_sun / D, is smooth). Returns (P ρ t, whether the sun is above the
-    horizon)."""
+def glint_sharp_factor(ct: torch.Tensor, st: torch.Tensor, cva: torch.Tensor, sva: torch.Tensor, vx: torch.Tensor,
+                       vy: torch.Tensor, cxy: torch.Tensor, mx: torch.Tensor, my: torch.Tensor, n: torch.Tensor,
+                       k: torch.Tensor, tz: torch.Tensor, tp: torch.Tensor, alpha: torch.Tensor
+                       ) -> tuple[torch.Tensor, torch.Tensor]:
+    """P ρ t of the glint (module docstring): the part of the glint that is sharp in the view direction
+    (the rest, L_sun / D, is smooth).
+
+    P is the Gaussian probability of the sun's ellipse in slope space; ρ and t = cos Ω / cos θ are the
+    Fresnel reflectance and the facet weight at the mean slope s* of the facets that mirror the sun.
+
+    Args:
+        ct, st, cva, sva: cos θ̂, sin θ̂, cos φ̂, sin φ̂ of the line of sight.
+        vx, vy, cxy: the slope covariance (upwind/crosswind frame); mx, my: the mean slope (tensors,
+            zero for a zero-mean law).
+        n, k: the refractive index m = n + i k.
+        tz, tp, alpha: the sun's zenith, azimuth and angular radius [rad].
+    All checked tensors of one dtype and device that broadcast together.
+
+    Returns:
+        (P ρ t, whether the sun is above the horizon), the broadcast shape.
+    """
     cxw, cyw, k11, k12, k22, det_k, l11, l21, l22, above = _specular_ellipse(ct, st, cva, sva, vx, vy, cxy, mx, my,
                                                                              tz, tp, alpha)
     shape = torch.broadcast_shapes(cxw.shape, cyw.shape, k11.shape, k12.shape, k22.shape, det_k.shape)
@@ -283,13 +296,25 @@ def _glint_sharp(ct: torch.Tensor, st: torch.Tensor, cva: torch.Tensor, sva: tor
     return 0.5 * (rs_ + rp_) * t_g * prob, above
 
 
-def _glint(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor,
-           mx: torch.Tensor | None, my: torch.Tensor | None, n: torch.Tensor, k: torch.Tensor, tz: torch.Tensor,
-           tp: torch.Tensor, e_sun: torch.Tensor, alpha: torch.Tensor, shadowing: bool, smooth: bool = False) -> Any:
-    """:func:`glint_radiance` without the sun's masking, on checked tensors (the renderer calls it on
-    its own pixels, whose values need no second check): P ρ t L_sun / D (:func:`_glint_sharp`).
-    With ``smooth``, only the smooth factor L_sun / D (0 for a sun below the horizon), which the
-    renderer tabulates."""
+def glint_from_moments(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor,
+                       mx: torch.Tensor | None, my: torch.Tensor | None, n: torch.Tensor, k: torch.Tensor,
+                       tz: torch.Tensor, tp: torch.Tensor, e_sun: torch.Tensor, alpha: torch.Tensor, shadowing: bool,
+                       smooth: bool = False) -> Any:
+    """:func:`glint_radiance` without the sun's masking, from the slope moments as checked tensors (the
+    renderer calls it on its own pixels, whose values need no second check): P ρ t L_sun / D
+    (:func:`glint_sharp_factor`) [W m⁻² sr⁻¹ in the irradiance's band].
+
+    Args:
+        vz, va: θ̂, φ̂ of the line of sight [rad].
+        vx, vy, cxy: the slope covariance; mx, my: the mean slope, or None for zero mean.
+        n, k: the refractive index m = n + i k.
+        tz, tp: the sun's zenith and azimuth [rad]; e_sun: its irradiance [W m⁻²]; alpha: its angular
+            radius [rad].
+        shadowing: Eq. 5 (True) or Eq. 7 for D.
+        smooth: only the smooth factor L_sun / D (0 for a sun below the horizon), which the renderer
+            tabulates.
+    All tensors of one dtype and device that broadcast together; the result has the broadcast shape.
+    """
     dtype, device = vz.dtype, vz.device
     zero = torch.zeros((), dtype=dtype, device=device)
     if mx is None:
@@ -298,8 +323,8 @@ def _glint(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tenso
     l_sun = e_sun / (4.0 * math.pi * torch.sin(0.5 * alpha) ** 2)  # Ω_sun = 2π(1 − cos α), without cancellation
     if smooth:
         return torch.where(torch.cos(tz) > 0, l_sun / D, zero)
-    sharp, above = _glint_sharp(torch.cos(vz), torch.sin(vz), torch.cos(va), torch.sin(va), vx, vy, cxy, mx, my, n,
-                                   k, tz, tp, alpha)
+    sharp, above = glint_sharp_factor(torch.cos(vz), torch.sin(vz), torch.cos(va), torch.sin(va), vx, vy, cxy, mx, my,
+                                      n, k, tz, tp, alpha)
     return torch.where(above, sharp * l_sun / D, zero)
 
 
@@ -317,3 +342,8 @@ def sun_masking_factor(slopes: Any, sun: Sun, dtype: torch.dtype = torch.float64
     d_sun = denominator(gs, True)
     e_s = (gs.ct + gs.st * gs.mu).clamp_min(0.0)
     return (e_s / d_sun.clamp_min(torch.finfo(dtype).tiny)).clamp(0.0, 1.0)
+
+
+# TEMPORARY aliases for render.py until the renderer moves; the lead removes them at merge.
+_glint = glint_from_moments
+_glint_sharp = glint_sharp_factor

@@ -74,7 +74,8 @@ import numpy as np
 import torch
 import torch.nn.functional as F_nn
 
-from ._validation import as_tensor, check_finite_range, check_same_device, per_batch, resolve_dtype_device
+from ._validation import (ParsedSeeds, as_tensor, check_finite_range, check_same_device, parse_seeds, per_batch,
+                          resolve_dtype_device)
 
 __all__ = [
     "GRAVITY",
@@ -525,7 +526,7 @@ class WaveField:
             bands = WaveBands()
         if not isinstance(bands, WaveBands):
             raise ValueError(f"bands must be a WaveBands; got {type(bands).__name__}")
-        seeds = _seeds(seed)
+        seeds = parse_seeds(seed)
         _check_wind("wind_speed", wind_speed)
         check_finite_range("wind_direction", wind_direction, -MAX_WIND_DIRECTION, MAX_WIND_DIRECTION, unit="rad")
         _check_wave_age(inverse_wave_age)
@@ -855,12 +856,14 @@ class WaveField:
                 f = torch.broadcast_to(f, shape)
             except RuntimeError as err:
                 raise ValueError(f"footprint: shape {tuple(f.shape)} does not broadcast to x {tuple(shape)}") from err
-        return self._sample(xt, yt, t_s, f, elevation, crest)
+        return self.sample_unchecked(xt, yt, t_s, f, elevation, crest)
 
-    def _sample(self, xt: torch.Tensor, yt: torch.Tensor, t_s: torch.Tensor, f: torch.Tensor | None, elevation: bool,
-                crest: bool) -> dict[str, torch.Tensor]:
-        """:meth:`sample` on arguments already checked: x, y (B, ...) of the field's dtype, finite; times
-        (B,) float64; footprints of x's shape (≥ 0) or None."""
+    def sample_unchecked(self, xt: torch.Tensor, yt: torch.Tensor, t_s: torch.Tensor, f: torch.Tensor | None,
+                         elevation: bool, crest: bool) -> dict[str, torch.Tensor]:
+        """:meth:`sample` without its input checks, for callers whose arguments are checked already (the
+        renderer's own pixels): ``xt``, ``yt`` (B, ...) of the field's dtype and device, finite; times
+        ``t_s`` (B,) float64 within ±MAX_TIME_S; footprints ``f`` of x's shape (≥ 0) or None. Returns what
+        :meth:`sample` returns; unchecked input gives unchecked output (NaN, wrong shapes)."""
         shape = xt.shape
         batch = self.batch_size
         npts = int(np.prod(shape[1:])) if len(shape) > 1 else 1
@@ -873,6 +876,9 @@ class WaveField:
         tiles = self._tiles(t_s, elevation, crest)
         acc = self._sample_points(tiles, xy, f)
         return {name: acc[:, c].reshape(shape) for c, name in enumerate(names)}
+
+    # TEMPORARY alias for clutter.TextureTable until the renderer moves; the lead removes it at merge.
+    _sample = sample_unchecked
 
     def _sample_points(self, tiles: torch.Tensor, xy: torch.Tensor, f: torch.Tensor | None) -> torch.Tensor:
         """Σ_o w_o · bilinear(tile_o) at points xy (B, P, 2) → (B, C, P).
@@ -964,46 +970,7 @@ def _runs(blocks: np.ndarray, npts: int, gap: int = 4) -> list[tuple[int, int]]:
 # ---------------------------------------------------------------------------------------------
 # argument helpers
 # ---------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class _Seeds:
-    values: tuple[int, ...]
-    single: bool
-
-
-def _seeds(seed: Any) -> _Seeds:
-    if isinstance(seed, bool):
-        raise ValueError("seed must be an int or a sequence / 1-D integer tensor of B ints; got a bool")
-    if isinstance(seed, Integral):  # Python and numpy integers (np.int64 from a shard)
-        values, single = [int(seed)], True
-    elif isinstance(seed, torch.Tensor):
-        if seed.dtype.is_floating_point or seed.dtype.is_complex or seed.dtype == torch.bool or seed.ndim > 1:
-            raise ValueError(
-                f"seed: a tensor of seeds must be 0-D or 1-D with an integer dtype; got {seed.dtype} of shape {tuple(seed.shape)}"
-            )
-        values, single = ([int(seed)], True) if seed.ndim == 0 else ([int(v) for v in seed.tolist()], False)
-    elif isinstance(seed, np.ndarray) and seed.ndim == 0:  # a 0-D array is one seed, as a numpy integer
-        return _seeds(seed[()])
-    elif isinstance(seed, (Sequence, np.ndarray)) and not isinstance(seed, (str, bytes)):
-        if isinstance(seed, np.ndarray) and seed.ndim != 1:
-            raise ValueError(f"seed: an array of seeds must be 1-D (one per image); got shape {seed.shape}")
-        items = seed.tolist() if isinstance(seed, np.ndarray) else list(seed)
-        values = []
-        for v in items:
-            if isinstance(v, bool) or not isinstance(v, Integral):
-                raise ValueError(f"seed: every seed must be an int; got {v!r}")
-            values.append(int(v))
-        single = False
-    else:
-        raise ValueError(f"seed must be an int or a sequence / 1-D integer tensor of B ints; got {type(seed).__name__}")
-    if not values:
-        raise ValueError("seed: need at least one seed (B ≥ 1)")
-    for v in values:
-        if not 0 <= v < 2**63:
-            raise ValueError(f"seed: each seed must lie in [0, 2**63); got {v}")
-    return _Seeds(tuple(values), single)
-
-
-def _batch_size(seeds: _Seeds, **items: Any) -> int:
+def _batch_size(seeds: ParsedSeeds, **items: Any) -> int:
     """B from the per-image arguments: tensors/arrays of shape (B,) and the seed sequence."""
     sizes: dict[str, int] = {}
     if not seeds.single:
@@ -1018,3 +985,8 @@ def _batch_size(seeds: _Seeds, **items: Any) -> int:
         listing = ", ".join(f"{k} has {v}" for k, v in sizes.items())
         raise ValueError(f"seed, wind_speed, wind_direction, inverse_wave_age: batch sizes differ ({listing})")
     return distinct.pop() if distinct else 1
+
+
+# TEMPORARY alias for render.py until the renderer moves (seed parsing is _validation.parse_seeds); the lead
+# removes it at merge.
+_seeds = parse_seeds
