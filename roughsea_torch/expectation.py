@@ -47,11 +47,12 @@ import torch
 
 from ._parallel import map_chunks
 from ._validation import as_tensor, check_finite_range, check_same_device
+from .atmosphere import as_sky
 from .facets import FacetGeometry, denominator, facet_geometry, normal_cdf, normal_pdf, prepare_inputs
 from .foam import foam_radiance, sky_hemispherical_mean, with_foam
 from .optics import fresnel_terms, split_refractive_index
 from .radiometry import LWIR
-from .sky import ConstantSky, TabulatedSky, as_sky, select_sky
+from .sky import ConstantSky, TabulatedSky, select_sky
 from .slopes import SlopeStatistics
 from .sun import Sun, glint_radiance
 

@@ -70,12 +70,13 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import torch
 
 from ._validation import as_tensor, check_finite_range, resolve_dtype_device
+from .atmosphere import as_sky
 from .optics import fresnel_emissivity
 from .radiometry import LWIR, MWIR, as_band
 
@@ -236,7 +237,7 @@ def sky_hemispherical_mean(
     Args:
         sky: R_s as a callable of cos(zenith) (receives a tensor of shape (n,), returns (..., n)),
             a constant (float or tensor, returned as is: its mean is itself), or any form
-            :func:`~roughsea_torch.sky.as_sky` accepts (table, named atmosphere).
+            :func:`~roughsea_torch.atmosphere.as_sky` accepts (table, named atmosphere).
         n: number of nodes, ≥ 1.
         dtype, device: of the nodes given to a callable sky (default ``torch.get_default_dtype()``
             and CPU); for a float constant, of the result.
@@ -256,8 +257,6 @@ def sky_hemispherical_mean(
     if sky is None:
         raise ValueError("sky is required: a callable of cos(zenith), a (zenith, radiance) table or a constant")
     if not callable(sky):
-        from .sky import as_sky
-
         sky = as_sky(sky)
     dt = dtype if dtype is not None else torch.get_default_dtype()
     if dt not in (torch.float32, torch.float64):

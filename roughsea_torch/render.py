@@ -46,7 +46,8 @@ from .clutter import TextureTable
 from .geometry import EARTH_RADIUS_M, CameraGeometry, ViewGeometry, view_geometry
 from .optics import band_refractive_index, split_refractive_index
 from .radiometry import LWIR, SpectralBand, as_band, band_radiance, brightness_temperature
-from .sky import ConstantSky, TabulatedSky, as_sky, select_sky
+from .atmosphere import as_sky
+from .sky import ConstantSky, TabulatedSky, select_sky
 from .slopes import SlopeStatistics
 from .waves import MAX_WIND_DIRECTION, _seeds, check_time
 

