@@ -78,7 +78,7 @@ import torch
 from ._validation import as_tensor, check_finite_range, resolve_dtype_device
 from .atmosphere import as_sky
 from .optics import fresnel_emissivity
-from .radiometry import LWIR, MWIR, as_band
+from .radiometry import LWIR, as_band
 
 __all__ = [
     "MONAHAN_COEFFICIENT",
