@@ -38,11 +38,8 @@ finite.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
-from functools import lru_cache
 from typing import Any, Callable
 
-import numpy as np
 import torch
 
 from ._parallel import map_chunks
@@ -51,6 +48,7 @@ from .atmosphere import as_sky
 from .facets import FacetGeometry, denominator, facet_geometry, normal_cdf, normal_pdf, prepare_inputs
 from .foam import foam_radiance, sky_hemispherical_mean, with_foam
 from .optics import fresnel_terms, split_refractive_index
+from .quadrature import Quadrature, gauss_nodes
 from .radiometry import LWIR
 from .sky import ConstantSky, TabulatedSky, select_sky
 from .slopes import SlopeStatistics
@@ -65,79 +63,13 @@ __all__ = [
     "reflection_terms",
 ]
 
-@dataclass(frozen=True)
-class Quadrature:
-    """Accuracy control of the expectation.
-
-    Args:
-        outer: Gauss–Legendre nodes along s∥ (both integrals), per panel: the sky integral splits
-            its outer range in three panels where the Gaussian ridge leaves the sky disc when the
-            slopes are anisotropic across the view (κ ≠ 0), one panel otherwise.
-        inner: Gauss–Legendre nodes across the sky disc (apparent radiance).
-        hermite: Gauss–Hermite nodes across s∥ (emissivity).
-        width: half-width of the Gaussian window, in standard deviations (mass beyond it is
-            dropped: 2·(1 − Φ(width))).
-        chunk: largest number of quadrature points held at once (memory bound; results do not
-            depend on it).
-        split: the sky integral splits its outer panel where the Gaussian ridge leaves the sky
-            disc when the conditional rms slope τ < split · |κ| · σ∥ somewhere in a chunk.
-
-    ``Quadrature.default(dtype)`` is what every function uses when ``quadrature=None``; it meets
-    a relative error of 1e-6 in float64 and 1e-5 in float32 against a converged reference over
-    the model's range with a smooth sky (``pipelines/accuracy_core.py``); error against run time
-    of every setting, and where it sits on the Pareto front: ``pipelines/accuracy_pareto.py``;
-    the extremes, and the regimes where the default does worse (a tabulated sky's C¹ kinks, a
-    sky far colder than the sea at grazing): ``pipelines/stability.py``.
-    """
-
-    outer: int = 28
-    inner: int = 28
-    hermite: int = 12
-    width: float = 7.5
-    chunk: int = 1 << 18
-    split: float = 2.0
-
-    def __post_init__(self) -> None:
-        for name in ("outer", "inner", "hermite"):
-            v = getattr(self, name)
-            if not isinstance(v, int) or v < 1 or v > 512:
-                raise ValueError(f"Quadrature.{name} must be an int in [1, 512]; got {v!r}")
-        if not (1.0 <= float(self.width) <= 40.0):
-            raise ValueError(f"Quadrature.width must lie in [1, 40] standard deviations; got {self.width!r}")
-        if not isinstance(self.chunk, int) or self.chunk < 1024:
-            raise ValueError(f"Quadrature.chunk must be an int >= 1024; got {self.chunk!r}")
-
-    @staticmethod
-    def default(dtype: torch.dtype = torch.float64) -> Quadrature:
-        if dtype == torch.float32:
-            return Quadrature(outer=20, inner=20, hermite=8, width=6.0)
-        return Quadrature(outer=28, inner=28, hermite=12, width=7.5)
-
-    def with_(self, **kw: Any) -> Quadrature:
-        return replace(self, **kw)
-
-
-@lru_cache(maxsize=64)
-def _gl_np(n: int) -> tuple[np.ndarray, np.ndarray]:
-    return np.polynomial.legendre.leggauss(n)
-
-
-@lru_cache(maxsize=64)
-def _gh_np(n: int) -> tuple[np.ndarray, np.ndarray]:
-    x, w = np.polynomial.hermite_e.hermegauss(n)
-    return x, w / w.sum()
-
-
-def _nodes(kind: str, n: int, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, torch.Tensor]:
-    x, w = (_gl_np if kind == "gl" else _gh_np)(n)
-    return torch.as_tensor(x, dtype=dtype, device=device), torch.as_tensor(w, dtype=dtype, device=device)
 
 
 def _asin2(x: torch.Tensor) -> torch.Tensor:
     """2 asin(x) with x clamped to [−1, 1] and a zero (not NaN) gradient where |x| ≥ 1.
 
-    ``asin(x.clamp(-1, 1))`` passes the gradient through at |x| = 1 exactly, where asin' = ∞, and
-    0 · ∞ = NaN reached the inputs' gradients (float32, a = 0 viewed crosswind near grazing).
+    ``asin(x.clamp(-1, 1))`` would pass the gradient through at |x| = 1 exactly, where asin' = ∞,
+    and 0 · ∞ = NaN would reach the inputs' gradients (``docs/notes/expectation.md``).
     """
     inside = x.abs() < 1.0
     safe = torch.where(inside, x, torch.zeros_like(x))
@@ -155,8 +87,8 @@ def _emissivity_numerator(
 ) -> torch.Tensor:
     """∫ N t (1 − ρ(|cos Ω|)) ds over t > 0 (and t < 0 without shadowing, negative weight)."""
     dtype, device = g.ct.dtype, g.ct.device
-    xg, wg = _nodes("gl", q.outer, dtype, device)
-    zh, wh = _nodes("gh", q.hermite, dtype, device)
+    xg, wg = gauss_nodes("gl", q.outer, dtype, device)
+    zh, wh = gauss_nodes("gh", q.hermite, dtype, device)
     K = float(q.width)
     a = g.st * g.su
     e = g.ct + g.st * g.mu  # the mean of t
@@ -197,10 +129,51 @@ def _sky_numerator(
     sea, R_B, which the form R_B (1 − T_ρ) + T_s then takes care of)."""
     dtype, device = g.ct.dtype, g.ct.device
     tiny = torch.finfo(dtype).tiny
-    xo, wo = _nodes("gl", q.outer, dtype, device)
-    xi, wi = _nodes("gl", q.inner, dtype, device)
+    xo, wo = gauss_nodes("gl", q.outer, dtype, device)
+    xi, wi = gauss_nodes("gl", q.inner, dtype, device)
     K = float(q.width)
     ct, st, su = g.ct, g.st, g.su
+    mu, mv = g.mu, g.mv
+    lo, hi, psi0 = _sky_panels(g, K, split, tiny)
+    half = (0.5 * (hi - lo))[..., None]  # (m, P, 1)
+    delta = ((0.5 * (hi + lo))[..., None] + half * xo).flatten(1)  # (m, P·no)
+    wdelta = (half * wo).flatten(1)
+    inv_ct = (1.0 / ct)[:, None]
+    u = 2.0 * inv_ct * torch.sin(psi0[:, None] + 0.5 * delta) * torch.sin(0.5 * delta)
+    h = (inv_ct * torch.sin(psi0[:, None] + delta)).clamp_min(0.0)  # half-chord = du/dψ
+    x = (u - mu[:, None]) / su[:, None]
+    W = wdelta * h * normal_pdf(x) / su[:, None]
+    t = ct[:, None] + st[:, None] * u
+    c = mv[:, None] + g.kappa[:, None] * (u - mu[:, None])
+    tau = g.tau[:, None]
+    z_lo = ((-h - c) / tau).clamp(-K, K)
+    z_hi = ((h - c) / tau).clamp(-K, K)
+    zh = 0.5 * (z_hi - z_lo)
+    z = (0.5 * (z_hi + z_lo))[..., None] + zh[..., None] * xi  # (m, P·no, ni)
+    Wz = zh[..., None] * wi * normal_pdf(z)
+    v = c[..., None] + tau[..., None] * z
+    inv = 1.0 / (1.0 + u[..., None] ** 2 + v * v)
+    cos_o = (t[..., None] * torch.sqrt(inv)).clamp(0.0, 1.0)
+    hh = h[..., None]
+    cos_r = (ct[:, None, None] * (hh - v) * (hh + v) * inv).clamp(0.0, 1.0)
+    rs, rp = fresnel_terms(cos_o, n[:, None, None], k[:, None, None])
+    m = cos_r.shape[0]
+    radiance = sky(cos_r.reshape(m, -1)).reshape(cos_r.shape)
+    w_rho = Wz * 0.5 * (rs + rp)
+    if masking:
+        w_rho = w_rho / (1.0 + _reflected_ray_lambda(g, u, v, t, inv, cos_r, tiny))
+    wt = W * t
+    return (wt * (w_rho * radiance).sum(-1)).sum(-1), (wt * w_rho.sum(-1)).sum(-1)
+
+
+def _sky_panels(g: FacetGeometry, K: float, split: bool, tiny: float
+                ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The outer panels of the sky integral in δ = ψ − ψ₀ (ψ the polar angle about the sky disc's
+    centre, ψ₀ its value at u = 0): (lo, hi) of shape (m, P), P = 3 with ``split`` else 1, and ψ₀.
+    The Gaussian window [m∥ − Kσ∥, m∥ + Kσ∥] is cut to the disc, and with ``split`` the panel is also
+    split where the Gaussian ridge leaves the disc."""
+    ct, st, su = g.ct, g.st, g.su
+    mu, mv = g.mu, g.mv
     alpha = ct / (1.0 + st)  # −u at the near edge of the disc
     B = ct * torch.rsqrt(2.0 * (1.0 + st))  # sin(ψ₀/2)
     psi0 = 2.0 * torch.asin(B)
@@ -214,7 +187,6 @@ def _sky_numerator(
         return _asin2(d / (A * sqrt_1mB2 + B * C))
 
     u_far = (1.0 + st) / ct
-    mu, mv = g.mu, g.mv
     u_lo = torch.maximum(-alpha, mu - K * su)
     u_hi = torch.minimum(u_far, mu + K * su)
     # At the disc's own edges the angle is exact (ψ = 0, π): shift() would take the square root of
@@ -246,47 +218,26 @@ def _sky_numerator(
         panels = [(d_lo, d_hi)]
     lo = torch.stack([a for a, _ in panels], -1)  # (m, P)
     hi = torch.stack([b for _, b in panels], -1)
-    half = (0.5 * (hi - lo))[..., None]  # (m, P, 1)
-    delta = ((0.5 * (hi + lo))[..., None] + half * xo).flatten(1)  # (m, P·no)
-    wdelta = (half * wo).flatten(1)
-    inv_ct = (1.0 / ct)[:, None]
-    u = 2.0 * inv_ct * torch.sin(psi0[:, None] + 0.5 * delta) * torch.sin(0.5 * delta)
-    h = (inv_ct * torch.sin(psi0[:, None] + delta)).clamp_min(0.0)  # half-chord = du/dψ
-    x = (u - mu[:, None]) / su[:, None]
-    W = wdelta * h * normal_pdf(x) / su[:, None]
-    t = ct[:, None] + st[:, None] * u
-    c = mv[:, None] + g.kappa[:, None] * (u - mu[:, None])
-    tau = g.tau[:, None]
-    z_lo = ((-h - c) / tau).clamp(-K, K)
-    z_hi = ((h - c) / tau).clamp(-K, K)
-    zh = 0.5 * (z_hi - z_lo)
-    z = (0.5 * (z_hi + z_lo))[..., None] + zh[..., None] * xi  # (m, P·no, ni)
-    Wz = zh[..., None] * wi * normal_pdf(z)
-    v = c[..., None] + tau[..., None] * z
-    inv = 1.0 / (1.0 + u[..., None] ** 2 + v * v)
-    cos_o = (t[..., None] * torch.sqrt(inv)).clamp(0.0, 1.0)
-    hh = h[..., None]
-    cos_r = (ct[:, None, None] * (hh - v) * (hh + v) * inv).clamp(0.0, 1.0)
-    rs, rp = fresnel_terms(cos_o, n[:, None, None], k[:, None, None])
-    m = cos_r.shape[0]
-    radiance = sky(cos_r.reshape(m, -1)).reshape(cos_r.shape)
-    w_rho = Wz * 0.5 * (rs + rp)
-    if masking:
-        # the reflected ray r = 2 (n·v) n − v in the view frame (u along the view, v across), and the
-        # rms slope of the law along r's azimuth: Λ = [φ(μ) − μ (1 − Φ(μ))]/μ, μ = cot θ'/σ(r)
-        uu = u[..., None]
-        rx = 2.0 * t[..., None] * uu * inv - st[:, None, None]
-        ry = 2.0 * t[..., None] * v * inv
-        rh2 = (rx * rx + ry * ry).clamp_min(tiny)
-        su2 = (su * su)[:, None, None]
-        kap, tau2 = g.kappa[:, None, None], (g.tau * g.tau)[:, None, None]
-        s2 = (su2 * rx * rx + 2.0 * kap * su2 * rx * ry + (tau2 + kap * kap * su2) * ry * ry) / rh2
-        mu_r = cos_r / torch.sqrt(rh2 * s2.clamp_min(tiny))
-        mu_c = mu_r.clamp_min(1e-6)
-        lam = (normal_pdf(mu_c) - mu_c * normal_cdf(-mu_c)) / mu_c
-        w_rho = w_rho / (1.0 + lam)
-    wt = W * t
-    return (wt * (w_rho * radiance).sum(-1)).sum(-1), (wt * w_rho.sum(-1)).sum(-1)
+    return lo, hi, psi0
+
+
+def _reflected_ray_lambda(g: FacetGeometry, u: torch.Tensor, v: torch.Tensor, t: torch.Tensor, inv: torch.Tensor,
+                          cos_r: torch.Tensor, tiny: float) -> torch.Tensor:
+    """Smith's Λ of the reflected ray at the sky integral's nodes (facet slopes u, v in the view frame,
+    t = cos Ω / cos θ, inv = 1/(1 + |s|²), cos θ' = ``cos_r``): G1 = 1/(1 + Λ)."""
+    st, su = g.st, g.su
+    # the reflected ray r = 2 (n·v) n − v in the view frame (u along the view, v across), and the
+    # rms slope of the law along r's azimuth: Λ = [φ(μ) − μ (1 − Φ(μ))]/μ, μ = cot θ'/σ(r)
+    uu = u[..., None]
+    rx = 2.0 * t[..., None] * uu * inv - st[:, None, None]
+    ry = 2.0 * t[..., None] * v * inv
+    rh2 = (rx * rx + ry * ry).clamp_min(tiny)
+    su2 = (su * su)[:, None, None]
+    kap, tau2 = g.kappa[:, None, None], (g.tau * g.tau)[:, None, None]
+    s2 = (su2 * rx * rx + 2.0 * kap * su2 * rx * ry + (tau2 + kap * kap * su2) * ry * ry) / rh2
+    mu_r = cos_r / torch.sqrt(rh2 * s2.clamp_min(tiny))
+    mu_c = mu_r.clamp_min(1e-6)
+    return (normal_pdf(mu_c) - mu_c * normal_cdf(-mu_c)) / mu_c
 
 
 def _sky_terms(
@@ -453,8 +404,8 @@ def _work_dtype(dtype: torch.dtype, shadowing: bool) -> torch.dtype:
     positive one: near grazing ε̄ ~ cos θ̂ while each part is ~σ∥, a condition number ~σ∥ tan θ̂
     (10³ at 89.99°); and R_a = R_B (1 − T_ρ) + T_s with T_ρ, T_s/R_B ~ σ∥/cos θ̂ ≫ 1 cancel to
     R_B + O(1). Both are computed in float64 whatever the dtype, and the result is rounded once
-    (in float32 they reached 1e-4 at θ̂ ≥ 89.9999°, ``pipelines/stability.py``). With shadowing
-    (T_ρ ≤ 1, ε̄ a mean of positive terms) the dtype itself is used.
+    (the float32 errors this avoids: ``docs/notes/expectation.md``). With shadowing (T_ρ ≤ 1, ε̄ a
+    mean of positive terms) the dtype itself is used.
     """
     return torch.float64 if not shadowing else dtype
 

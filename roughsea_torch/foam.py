@@ -322,22 +322,18 @@ def crest_foam_fraction(
     whatever σ_u: the floor ρ and the position-averaged variances only shape the pattern, never
     the ensemble mean (c is taken with the same σ_r² + σ_u²). Far field: σ_r = 0, X_r = 0 give
     f_pix = Φ(−Φ⁻¹(1 − W)) = W, the uniform-fraction image. Only a σ_r² that is not the true variance
-    of X_r at the point moves the mean: with :meth:`WaveField.crest_variance` (a position average)
-    the bilinear interpolation of the band tiles leaves a texel-scale ripple of the point variance
-    (``waves.WaveField``, *Evaluation*) that averages out over positions.
+    of X_r at the point moves the mean: :meth:`WaveField.crest_variance` is a position average, and
+    the texel-scale ripple of the point variance about it averages out over positions.
 
     No bias of the slope texture. Each Fourier component's X is in phase with its elevation and its
     slope in quadrature, so X_r and the resolved slope at a point are uncorrelated, hence (Gaussian)
     independent: the foam mixture leaves the ensemble mean of the slope-driven texture unchanged,
     E[(1 − f_pix) T] = (1 − W) E[T].
 
-    Which crest. X is the :class:`~roughsea_torch.waves.WaveField`'s crest variable
-    (``sample(..., crest=True)``, :meth:`~roughsea_torch.waves.WaveField.crest_variance`): the
-    downward vertical acceleration −a_z/g of the waves from the spectral peak to about ten times
-    its wavenumber (see there for the sources and the reasons). The construction itself holds for
-    any zero-mean Gaussian field: the elevation η (``sample(..., elevation=True)``,
-    :meth:`~roughsea_torch.waves.WaveField.elevation_variance`) puts the foam on the tops of the
-    highest (dominant) crests instead.
+    Which crest. X is the :class:`~roughsea_torch.waves.WaveField`'s crest variable (``sample(...,
+    crest=True)``): the downward vertical acceleration −a_z/g of the waves from the spectral peak to
+    about ten times its wavenumber (sources there). Any zero-mean Gaussian field works: the elevation
+    η puts the foam on the tops of the highest (dominant) crests instead.
 
     Degenerate ends. W = 0 gives exactly 0 (below W = 1e-30, f_pix is the value at 1e-30 scaled
     by W/1e-30, which keeps the mean exact and the gradient finite); W = 1 gives exactly 1 (W is
