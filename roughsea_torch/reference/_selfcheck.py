@@ -15,8 +15,8 @@ from scipy import integrate, special, stats
 from roughsea_torch.reference import (SlopeStatistics, apparent_radiance, band_radiance,
                                       brightness_temperature, emissivity, fresnel_reflectance,
                                       planck_radiance, projected_area, slope_pdf)
-from roughsea_torch.reference.fresnel import _fresnel_scalar
-from roughsea_torch.reference.rough_sea import _numerator
+from roughsea_torch.reference.fresnel import fresnel_scalar
+from roughsea_torch.reference.rough_sea import numerator
 
 DEG = math.pi / 180.0
 HQ = {"4um": complex(1.351, 0.0046), "10um": complex(1.218, 0.0508),
@@ -175,12 +175,12 @@ def check_facts():
     # emissivity of a very calm sea tends to the flat value
     calm = SlopeStatistics(1e-6, 1e-6)
     e = float(emissivity(85 * DEG, 0.0, calm, HQ["11um"]))
-    print(f"  rms slope 1e-6 (quadrature), 11um, 85 deg: {e:.10f} vs flat {1 - _fresnel_scalar(math.cos(85 * DEG), HQ['11um']):.10f}")
+    print(f"  rms slope 1e-6 (quadrature), 11um, 85 deg: {e:.10f} vs flat {1 - fresnel_scalar(math.cos(85 * DEG), HQ['11um']):.10f}")
     # unnormalized emissivity (Eq. 5 numerator divided by cos th instead of D)
     S15 = SlopeStatistics.cox_munk(15.0)
     a = float(S15.std_upwind)
     th = 85 * DEG
-    num = _numerator("emis", th, 0.0, a, a, 0.0, True, m=HQ["11um"])
+    num = numerator("emis", th, 0.0, a, a, 0.0, True, m=HQ["11um"])
     d = float(projected_area(th, 0.0, S15))
     e_norm = float(emissivity(th, 0.0, S15, HQ["11um"]))
     print(f"  W=15 iso, 11um, 85 deg: unnormalized (num/cos th) = {num / math.cos(th):.4f}  (physics.md ~1.19);"
@@ -212,7 +212,7 @@ def check_misc():
         print(f"  Fresnel n=1.33 {deg:4.1f} deg: s {mine_s:.15f} vs Snell {rs:.15f}; p {mine_p:.15f} vs {rp:.15f}")
     c = np.linspace(-1, 1, 41)
     v = fresnel_reflectance(c, np.array([HQ['10um']]))
-    sc = np.array([_fresnel_scalar(abs(x), HQ['10um']) for x in c])
+    sc = np.array([fresnel_scalar(abs(x), HQ['10um']) for x in c])
     print(f"  vectorized vs scalar Fresnel, max diff {np.max(np.abs(v - sc)):.1e}; even in cos: "
           f"{np.max(np.abs(v - v[::-1])):.1e}; rho(cos=0) = {float(fresnel_reflectance(0.0, HQ['10um'])):.15f}")
     # Planck
