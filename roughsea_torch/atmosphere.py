@@ -89,7 +89,7 @@ def as_sky(sky: Any) -> Callable[[torch.Tensor], torch.Tensor]:
 
 
 # TEMPORARY aliases for pipelines/lowtran_tables.py, lowtran_observer_sky.py and lowtran_daysky.py, which read
-# the tables through these (formerly private) names of this module; remove once they call
+# the tables through these private names of this module (as it was before the split); remove once they call
 # roughsea_torch._tables.read_table and roughsea_torch.lowtran.atmosphere_tables.
 _read = read_table
 _tables = atmosphere_tables

@@ -295,7 +295,7 @@ def with_foam(apparent_radiance: Any, foam_fraction: Any, foam_radiance: Any) ->
     return (1.0 - f) * ra + f * rf
 
 
-def crest_foam_fraction(
+def crest_foam_fraction(  # ~80 lines for its docstring (the derivation of the exact mean); the code is 15
     crest: Any,
     resolved_variance: Any,
     total_variance: Any,
@@ -317,13 +317,13 @@ def crest_foam_fraction(
     Φ the standard normal distribution function, W the whitecap fraction (Monahan &
     O'Muircheartaigh 1980, :func:`whitecap_fraction`), ρ = ``floor``.
 
-    Exact mean. For X_r ~ N(0, σ_r²) and Z ~ N(0, 1) independent,
-    E[Φ((X_r − c)/σ_u)] = P(X_r + σ_u Z > c) = P(N(0, σ_r² + σ_u²) > c) = Φ(−Φ⁻¹(1 − W)) = W,
-    whatever σ_u: the floor ρ and the position-averaged variances only shape the pattern, never
-    the ensemble mean (c is taken with the same σ_r² + σ_u²). Far field: σ_r = 0, X_r = 0 give
-    f_pix = Φ(−Φ⁻¹(1 − W)) = W, the uniform-fraction image. Only a σ_r² that is not the true variance
-    of X_r at the point moves the mean: :meth:`WaveField.crest_variance` is a position average, and
-    the texel-scale ripple of the point variance about it averages out over positions.
+    Exact mean. For X_r ~ N(0, σ_r²) and Z ~ N(0, 1) independent, E[Φ((X_r − c)/σ_u)] =
+    P(X_r + σ_u Z > c) = P(N(0, σ_r² + σ_u²) > c) = Φ(−Φ⁻¹(1 − W)) = W, whatever σ_u: the floor ρ and
+    the position-averaged variances only shape the pattern, never the ensemble mean (c is taken with
+    the same σ_r² + σ_u²). Far field: σ_r = 0, X_r = 0 give f_pix = W, the uniform-fraction image.
+    Only a σ_r² that is not the true variance of X_r at the point moves the mean:
+    :meth:`WaveField.crest_variance` is a position average, and the texel-scale ripple of the point
+    variance about it averages out over positions.
 
     No bias of the slope texture. Each Fourier component's X is in phase with its elevation and its
     slope in quadrature, so X_r and the resolved slope at a point are uncorrelated, hence (Gaussian)
@@ -335,11 +335,11 @@ def crest_foam_fraction(
     about ten times its wavenumber (sources there). Any zero-mean Gaussian field works: the elevation
     η puts the foam on the tops of the highest (dominant) crests instead.
 
-    Degenerate ends. W = 0 gives exactly 0 (below W = 1e-30, f_pix is the value at 1e-30 scaled
-    by W/1e-30, which keeps the mean exact and the gradient finite); W = 1 gives exactly 1 (W is
-    ≤ 0.3 where Monahan's law holds); σ_X² = 0 (a field without crest variance) gives f_pix = W;
-    σ_u → 0 (a footprint that resolves every band) would make f_pix a step in X_r: the floor ρ keeps
-    σ_u ≥ ρ σ_X (default 0.05, an edge 0.1 σ_X wide), so f_pix and its gradients stay finite.
+    Degenerate ends. W = 0 gives exactly 0 (below W = 1e-30, f_pix is the value at 1e-30 scaled by
+    W/1e-30: the mean stays exact, the gradient finite); W = 1 gives exactly 1; σ_X² = 0 (a field
+    without crest variance) gives f_pix = W; σ_u → 0 (a footprint that resolves every band) would make
+    f_pix a step in X_r: the floor ρ keeps σ_u ≥ ρ σ_X (default 0.05, an edge 0.1 σ_X wide), so f_pix
+    and its gradients stay finite.
 
     Args:
         crest: X_r, the pixel's resolved crest variable (or elevation [m]), any shape.

@@ -38,7 +38,10 @@ r(λ) B_λ(T_ref), T_ref defaulting to the surface air temperature, so that
 ``τ_band · L_band(T_ref) = ∫ τ r B_λ(T_ref) dλ`` exactly: the apparent radiance at the sensor is
 then ``τ_band · R_a + path_radiance`` to the extent that R_a's spectrum has the shape of B(T_ref).
 
-Every name here is also importable from :mod:`roughsea_torch.atmosphere`, where users find them.
+The loaders and tables users need (:func:`load_sky`, :func:`load_path`, :func:`load_spectral`,
+:func:`provenance`, ...) are also importable from :mod:`roughsea_torch.atmosphere`, where users find
+them; :func:`atmosphere_tables`, :func:`check_band`, :func:`sky_band_radiance`, :func:`check_dtype` and
+:func:`query_tensors` serve :mod:`roughsea_torch.observer_sky`, which builds on this module.
 """
 
 from __future__ import annotations

@@ -9,7 +9,8 @@ Source: LOWTRAN7 (AFGL; Kneizys et al. 1988, *Users guide to LOWTRAN 7*, AFGL-TR
 ``observer_<name>.npz`` made by ``pipelines/lowtran_observer_sky.py``; settings and every measured
 error in :func:`observer_provenance`. Interpolation and accuracy: :class:`ObserverSky`.
 
-Every public name here is also importable from :mod:`roughsea_torch.atmosphere`.
+:class:`ObserverSky`, :func:`load_observer_sky` and :func:`observer_provenance` are also importable
+from :mod:`roughsea_torch.atmosphere`.
 """
 
 from __future__ import annotations
