@@ -5,8 +5,8 @@ sun (:mod:`roughsea_torch.sun`) weight a facet of slope s = (s_x, s_y) by N(s; �
 
     t(s) = cos Ω / cos θ = cos θ̂ + sin θ̂ · s∥                     (Eq. 6 in slope form)
 
-s∥ the slope along the view azimuth φ̂ and s⊥ the slope across it (``docs/physics.md`` §3). This
-module holds what they share:
+s∥ the slope along the view azimuth φ̂ and s⊥ the slope across it. This module holds what they
+share:
 
 - :class:`FacetGeometry` and :func:`facet_geometry`: the slope law in that view frame, σ∥ (rms of
   s∥), κ and τ (s⊥ = κ s∥ + τ z, the regression of s⊥ on s∥ and the conditional rms) and the mean

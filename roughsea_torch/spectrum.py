@@ -9,8 +9,9 @@
   g = 9.81 m s⁻², k_m = 370 rad m⁻¹ (ECKV Eq. 24; phase-speed minimum c_m = √(2g/k_m) ≈ 0.23 m s⁻¹).
 
 The random sea surfaces synthesized from this spectrum are :class:`roughsea_torch.waves.WaveField`;
-every public name here is also importable from :mod:`roughsea_torch.waves`. Properties measured with
-this implementation (peak, Hs, mean-square slope against Cox & Munk): ``docs/notes/wave_spectrum.md``.
+the constants and the spectrum functions are also importable from :mod:`roughsea_torch.waves`.
+Properties measured with this implementation (peak, Hs, mean-square slope against Cox & Munk):
+``docs/notes/wave_spectrum.md``.
 
 Why not a library
 -----------------

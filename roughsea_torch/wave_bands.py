@@ -3,7 +3,7 @@
 A :class:`~roughsea_torch.waves.WaveField` splits the Fourier modes of the sea surface into bands
 of wavenumber (octaves by default), each synthesized on its own periodic tile (:class:`WaveBands`),
 so that each band can be faded out where a pixel footprint no longer resolves it
-(:func:`band_window`; ``docs/waves.md`` §2, the two-scale principle).
+(:func:`band_window`; the two-scale principle).
 
 Every public name here is also importable from :mod:`roughsea_torch.waves`.
 """
