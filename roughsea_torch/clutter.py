@@ -1,4 +1,4 @@
-"""Two-scale sea clutter: what one pixel of a textured sea sees (``docs/waves.md`` §2–3).
+"""Two-scale sea clutter: what one pixel of a textured sea sees (``docs/texture.md`` §5–6).
 
 A pixel's footprint splits the waves in two (Bruneton, Neyret & Holzschuch, *Real-time realistic
 ocean lighting using seamless transitions from geometry to BRDF*, CGF 29(2), 2010; the ONERA
@@ -217,7 +217,7 @@ def pixel_resolved_slope(
 
 
 def footprint(range_m: torch.Tensor, cos_t: torch.Tensor, ifov: torch.Tensor) -> torch.Tensor:
-    """Length [m] of a pixel's footprint on the sea along the view: R δ / cos θ̂ (``docs/waves.md``
+    """Length [m] of a pixel's footprint on the sea along the view: R δ / cos θ̂ (``docs/texture.md``
     §4; across the view it is R δ). The window of the resolved waves takes this, the longer side,
     so no wave shorter than the footprint in any direction is taken as geometry."""
     return range_m * ifov / cos_t.clamp_min(1e-9)

@@ -29,9 +29,9 @@ horizon (e.g. maritime, midlatitude summer: MWIR +4.6 %, LWIR +5.7 % at the zeni
 values for every case under ``aerosol_thermal_effect`` in the provenance). In the infrared Rayleigh scattering is negligible: the scattered sky is the aerosol's,
 largest in MWIR and towards the sun (the aerosol's forward-scattering aureole).
 
-Also here: :func:`direct_aerosol_transmittance`, the aerosol's dimming of the direct solar beam
-(LOWTRAN ``IEMSCT = 3`` with the same aerosols, ``solar_direct_aerosol.npz``), which
-:func:`roughsea_torch.solar.load_solar_irradiance` applies with ``aerosol=``.
+The aerosol's dimming of the direct solar beam with the same aerosols (LOWTRAN ``IEMSCT = 3``,
+``solar_direct_aerosol.npz``), which :func:`roughsea_torch.solar.load_solar_irradiance` applies with
+``aerosol=``, is :func:`roughsea_torch.solar.direct_aerosol_transmittance` (also importable from here).
 
 Example:
     >>> import math, torch
@@ -54,9 +54,10 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from .atmosphere import ATMOSPHERES, _dir, spectral_weights
+from ._tables import read_generated_table, table_index
+from .lowtran import ATMOSPHERES, spectral_weights
 from .radiometry import SpectralBand
-from .solar import disk_fraction
+from .solar import check_band, direct_aerosol_transmittance, disk_fraction
 
 __all__ = [
     "ATMOSPHERES",
@@ -69,7 +70,6 @@ __all__ = [
 ]
 
 TABLE = "daysky_scattered.npz"
-DIRECT_TABLE = "solar_direct_aerosol.npz"
 AEROSOLS = ("maritime", "rural")
 REFINE = 8  # fine-grid subdivisions per table cell (see ScatteredSky)
 _FLOOR = 1e-9  # band values below this fraction of the table's maximum are held at it (log)
@@ -81,23 +81,12 @@ _FLOOR = 1e-9  # band values below this fraction of the table's maximum are held
 
 
 def _read_table(name: str, data_dir: str | Path | None) -> dict[str, Any]:
-    from .atmosphere import _read  # one reader (read-only arrays, provenance parsed, cached)
-
-    p = _dir(data_dir) / name
-    if not p.is_file():
-        raise FileNotFoundError(f"no table at {p} (made by pipelines/lowtran_daysky.py)")
-    return _read(str(p))
-
-
-def _index(what: str, value: Any, names: list[str]) -> int:
-    if not isinstance(value, str) or value not in names:
-        raise ValueError(f"{what}: unknown {what} {value!r}; available: {', '.join(names)}")
-    return names.index(value)
+    return read_generated_table(name, data_dir, "pipelines/lowtran_daysky.py")
 
 
 def _indices(atmosphere: Any, aerosol: Any, t: dict[str, Any]) -> tuple[int, int]:
-    return (_index("atmosphere", atmosphere, [str(n) for n in t["atmospheres"]]),
-            _index("aerosol", aerosol, [str(n) for n in t["aerosols"]]))
+    return (table_index("atmosphere", atmosphere, [str(n) for n in t["atmospheres"]]),
+            table_index("aerosol", aerosol, [str(n) for n in t["aerosols"]]))
 
 
 def scattered_sky_provenance(data_dir: str | Path | None = None) -> dict[str, Any]:
@@ -151,29 +140,6 @@ def _band_nodes(t: dict[str, Any], ia: int, ib: int, weights: np.ndarray) -> np.
     for r, (mask, scale, coef) in enumerate(_node_coefficients(t, ia, ib)):
         out = out + scale * (coef @ (t[f"basis_{r}"].astype(np.float64) @ weights[mask]))
     return np.asarray(out, dtype=np.float64)
-
-
-def direct_aerosol_transmittance(atmosphere: str, aerosol: str, *,
-                                 data_dir: str | Path | None = None) -> np.ndarray:
-    """The aerosol's transmittance of the direct solar beam, τ_aer = E(aerosol) / E(no aerosol),
-    as LOWTRAN7 computes them (``IEMSCT = 3``, sea level, apparent sun zenith), (Nz, Nν) float64 on
-    the nodes of ``solar_direct.npz`` (its ``sun_zenith_rad`` × ``wavenumber_cm1``).
-
-    Stored as log τ_aer quantized to 2e-4 (differenced along wavenumber); where LOWTRAN's direct beam
-    without aerosol is ~0 (< 1e-30 of the sun above the atmosphere) the ratio is interpolated in
-    wavenumber (it multiplies ~0). Used by
-    :func:`roughsea_torch.solar.load_solar_irradiance` (``aerosol=``).
-    """
-    from .solar import _tables as _solar_tables
-
-    t = _read_table(DIRECT_TABLE, data_dir)
-    ia = _index("atmosphere", atmosphere, [str(n) for n in t["atmospheres"]])
-    ib = _index("aerosol", aerosol, [str(n) for n in t["aerosols"]])
-    z = _solar_tables(data_dir)["sun_zenith_rad"]
-    if z.shape != t["sun_zenith_rad"].shape or np.any(z != t["sun_zenith_rad"]):
-        raise ValueError(f"{DIRECT_TABLE} and solar_direct.npz in {_dir(data_dir)} have different sun-zenith nodes")
-    log_tau = np.cumsum(t["log_transmittance_dq"][ia, ib].astype(np.int64), axis=-1) * float(t["log_transmittance_step"])
-    return np.exp(np.minimum(log_tau, 0.0))
 
 
 # --------------------------------------------------------------------------------------------------
@@ -418,14 +384,12 @@ def load_scattered_sky(
         ValueError: unknown atmosphere or aerosol (lists the available ones), a band outside the
             table's wavelengths (gives the range), a bad response or distance.
     """
-    from .solar import _band as _solar_band  # the band checks of load_solar_irradiance
-
     if not (isinstance(distance_au, (int, float)) and 0.9 < float(distance_au) < 1.1):
         raise ValueError(f"distance_au: must be a number in (0.9, 1.1) AU, got {distance_au!r}")
     t = _read_table(TABLE, data_dir)
     ia, ib = _indices(atmosphere, aerosol, t)
     nu = t["wavenumber_cm1"].astype(np.float64)
-    b = _solar_band(band, response, nu)
+    b = check_band(band, response, nu)  # the band checks of load_solar_irradiance
     w = spectral_weights(1e-2 / nu, b)
     values = _band_nodes(t, ia, ib, w) / float(distance_au) ** 2
     return ScatteredSky(atmosphere, aerosol, b, t["sun_zenith_rad"], t["view_zenith_rad"],

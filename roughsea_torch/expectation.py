@@ -21,7 +21,7 @@ integrand on the boundary of its domain (so that Gauss rules converge spectrally
       R_a = R_B + (1/D) ∫_C N t ρ(Ω) [R_s(θ') − R_B] ds,
 
   where C is the disc (u − tan θ̂)² + v² < sec² θ̂ of facets whose reflected ray reaches the sky
-  (outside it the ray meets the sea and sees R_B, physics.md §2, so the integrand vanishes). The
+  (outside it the ray meets the sea and sees R_B, docs/physics.md §4, so the integrand vanishes). The
   disc is parametrized by ψ, its polar angle about its centre, u = tan θ̂ − sec θ̂ cos ψ, and the
   chord |v| < sec θ̂ sin ψ: its square-root edges become smooth. ψ is shifted by ψ₀ (u = 0) and the
   Gaussian window is mapped without cancellation, which keeps float32 accurate for σ down to 1e-3.
@@ -38,18 +38,21 @@ finite.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
-from functools import lru_cache
 from typing import Any, Callable
 
-import numpy as np
 import torch
 
 from ._parallel import map_chunks
-from ._validation import as_tensor, check_finite_range, check_same_device, resolve_dtype_device
-from .optics import _fresnel_terms, split_refractive_index
-from .sky import ConstantSky, TabulatedSky, as_sky, select_sky
+from ._validation import as_tensor, check_finite_range, check_same_device
+from .atmosphere import as_sky
+from .facets import FacetGeometry, denominator, facet_geometry, normal_cdf, normal_pdf, prepare_inputs
+from .foam import foam_radiance, sky_hemispherical_mean, with_foam
+from .optics import fresnel_terms, split_refractive_index
+from .quadrature import Quadrature, gauss_nodes
+from .radiometry import LWIR
+from .sky import ConstantSky, TabulatedSky, select_sky
 from .slopes import SlopeStatistics
+from .sun import Sun, glint_radiance
 
 __all__ = [
     "Quadrature",
@@ -60,91 +63,13 @@ __all__ = [
     "reflection_terms",
 ]
 
-_INV_SQRT_2PI = 1.0 / math.sqrt(2.0 * math.pi)
-_SQRT_HALF = math.sqrt(0.5)
-
-
-@dataclass(frozen=True)
-class Quadrature:
-    """Accuracy control of the expectation.
-
-    Args:
-        outer: Gauss–Legendre nodes along s∥ (both integrals), per panel: the sky integral splits
-            its outer range in three panels where the Gaussian ridge leaves the sky disc when the
-            slopes are anisotropic across the view (κ ≠ 0), one panel otherwise.
-        inner: Gauss–Legendre nodes across the sky disc (apparent radiance).
-        hermite: Gauss–Hermite nodes across s∥ (emissivity).
-        width: half-width of the Gaussian window, in standard deviations (mass beyond it is
-            dropped: 2·(1 − Φ(width))).
-        chunk: largest number of quadrature points held at once (memory bound; results do not
-            depend on it).
-        split: the sky integral splits its outer panel where the Gaussian ridge leaves the sky
-            disc when the conditional rms slope τ < split · |κ| · σ∥ somewhere in a chunk.
-
-    ``Quadrature.default(dtype)`` is what every function uses when ``quadrature=None``; it meets
-    a relative error of 1e-6 in float64 and 1e-5 in float32 against a converged reference over
-    the model's range with a smooth sky (``pipelines/accuracy_core.py``); error against run time
-    of every setting, and where it sits on the Pareto front: ``pipelines/accuracy_pareto.py``;
-    the extremes, and the regimes where the default does worse (a tabulated sky's C¹ kinks, a
-    sky far colder than the sea at grazing): ``pipelines/stability.py``.
-    """
-
-    outer: int = 28
-    inner: int = 28
-    hermite: int = 12
-    width: float = 7.5
-    chunk: int = 1 << 18
-    split: float = 2.0
-
-    def __post_init__(self) -> None:
-        for name in ("outer", "inner", "hermite"):
-            v = getattr(self, name)
-            if not isinstance(v, int) or v < 1 or v > 512:
-                raise ValueError(f"Quadrature.{name} must be an int in [1, 512]; got {v!r}")
-        if not (1.0 <= float(self.width) <= 40.0):
-            raise ValueError(f"Quadrature.width must lie in [1, 40] standard deviations; got {self.width!r}")
-        if not isinstance(self.chunk, int) or self.chunk < 1024:
-            raise ValueError(f"Quadrature.chunk must be an int >= 1024; got {self.chunk!r}")
-
-    @staticmethod
-    def default(dtype: torch.dtype = torch.float64) -> Quadrature:
-        if dtype == torch.float32:
-            return Quadrature(outer=20, inner=20, hermite=8, width=6.0)
-        return Quadrature(outer=28, inner=28, hermite=12, width=7.5)
-
-    def with_(self, **kw: Any) -> Quadrature:
-        return replace(self, **kw)
-
-
-@lru_cache(maxsize=64)
-def _gl_np(n: int) -> tuple[np.ndarray, np.ndarray]:
-    return np.polynomial.legendre.leggauss(n)
-
-
-@lru_cache(maxsize=64)
-def _gh_np(n: int) -> tuple[np.ndarray, np.ndarray]:
-    x, w = np.polynomial.hermite_e.hermegauss(n)
-    return x, w / w.sum()
-
-
-def _nodes(kind: str, n: int, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, torch.Tensor]:
-    x, w = (_gl_np if kind == "gl" else _gh_np)(n)
-    return torch.as_tensor(x, dtype=dtype, device=device), torch.as_tensor(w, dtype=dtype, device=device)
-
-
-def _phi(x: torch.Tensor) -> torch.Tensor:
-    return torch.exp(-0.5 * x * x) * _INV_SQRT_2PI
-
-
-def _Phi(x: torch.Tensor) -> torch.Tensor:
-    return 0.5 * torch.erfc(-x * _SQRT_HALF)
 
 
 def _asin2(x: torch.Tensor) -> torch.Tensor:
     """2 asin(x) with x clamped to [−1, 1] and a zero (not NaN) gradient where |x| ≥ 1.
 
-    ``asin(x.clamp(-1, 1))`` passes the gradient through at |x| = 1 exactly, where asin' = ∞, and
-    0 · ∞ = NaN reached the inputs' gradients (float32, a = 0 viewed crosswind near grazing).
+    ``asin(x.clamp(-1, 1))`` would pass the gradient through at |x| = 1 exactly, where asin' = ∞,
+    and 0 · ∞ = NaN would reach the inputs' gradients (``docs/notes/expectation.md``).
     """
     inside = x.abs() < 1.0
     safe = torch.where(inside, x, torch.zeros_like(x))
@@ -154,84 +79,16 @@ def _asin2(x: torch.Tensor) -> torch.Tensor:
 # -- per-evaluation geometry -----------------------------------------------------------------
 
 
-@dataclass
-class _Geom:
-    ct: torch.Tensor  # cos θ̂ (floored at a tiny positive value)
-    st: torch.Tensor  # sin θ̂
-    su: torch.Tensor  # σ∥, rms slope along the view azimuth
-    kappa: torch.Tensor  # regression of s⊥ on s∥
-    tau: torch.Tensor  # conditional rms of s⊥ given s∥
-    mu: torch.Tensor  # mean of s∥ (0 unless the statistics are shifted)
-    mv: torch.Tensor  # mean of s⊥
-
-    def _fields(self) -> tuple[torch.Tensor, ...]:
-        return (self.ct, self.st, self.su, self.kappa, self.tau, self.mu, self.mv)
-
-    def flat(self, shape: torch.Size) -> _Geom:
-        return _Geom(*(t.expand(shape).reshape(-1) for t in self._fields()))
-
-    def take(self, idx: torch.Tensor | slice) -> _Geom:
-        return _Geom(*(t[idx] for t in self._fields()))
-
-
-def _floors(dtype: torch.dtype) -> tuple[float, float]:
-    """(smallest cos θ̂ used, smallest rms slope used); both far below any physical effect.
-
-    The same in every dtype, so that float32 and float64 agree at the same (float32-held) input:
-    float32(π/2) lies above π/2, and a larger float32 floor (it was 1e-7) made the float32 value
-    there, and at the float32 angle below it (cos θ̂ = 7.5e-8), differ from float64's by up to 30 %
-    on a calm sea, where ε̄ ∝ cos θ̂ (``pipelines/stability.py``, ``tests/test_stability.py``).
-    """
-    return 1e-12, 1e-12
-
-
-def _geometry(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor,
-              mx: torch.Tensor | None = None, my: torch.Tensor | None = None) -> _Geom:
-    cmin, smin = _floors(vz.dtype)
-    ct = torch.cos(vz).clamp_min(cmin)
-    st = torch.sin(vz).clamp(0.0, 1.0)
-    c, s = torch.cos(va), torch.sin(va)
-    su2 = vx * c * c + 2.0 * cxy * c * s + vy * s * s
-    sv2 = vx * s * s - 2.0 * cxy * c * s + vy * c * c
-    cuv = (vy - vx) * c * s + cxy * (c * c - s * s)
-    det = vx * vy - cxy * cxy
-    ok = su2 > smin * smin
-    su2s = torch.where(ok, su2, torch.full_like(su2, smin * smin))
-    kappa = torch.where(ok, cuv / su2s, torch.zeros_like(su2))
-    tau2 = torch.where(ok, det / su2s, sv2)
-    tau = torch.sqrt(tau2.clamp_min(smin * smin))
-    if mx is None:
-        mu = mv = torch.zeros_like(su2)
-    else:  # the mean slope in the view frame (s∥, s⊥)
-        mu, mv = mx * c + my * s, my * c - mx * s
-    return _Geom(ct, st, torch.sqrt(su2s), kappa, tau, mu, mv)
-
-
-def _denominator(g: _Geom, shadowing: bool) -> torch.Tensor:
-    """D of Eq. 5 (shadowing) or Eq. 7 (cos θ̂), closed form (physics.md §3).
-
-    With a mean slope m∥ along the view, t = cos θ̂ + sin θ̂ s∥ has mean e = cos θ̂ + sin θ̂ m∥ and
-    D = E[t H(t)] = e Φ(e/a) + a φ(e/a), a = sin θ̂ σ∥ (Eq. 7: D = e)."""
-    e = g.ct + g.st * g.mu
-    if not shadowing:
-        return e
-    a = g.st * g.su
-    big = e > 40.0 * a  # μ > 40: Φ(μ) = 1, φ(μ) = 0 to every precision
-    mu = e / torch.where(big, torch.ones_like(a), a)
-    mu = torch.where(big, torch.full_like(mu, 40.0), mu)
-    return torch.where(big, e, e * _Phi(mu) + a * _phi(mu))
-
-
 # -- the two integrals -----------------------------------------------------------------------
 
 
 def _emissivity_numerator(
-    g: _Geom, n: torch.Tensor, k: torch.Tensor, shadowing: bool, q: Quadrature
+    g: FacetGeometry, n: torch.Tensor, k: torch.Tensor, shadowing: bool, q: Quadrature
 ) -> torch.Tensor:
     """∫ N t (1 − ρ(|cos Ω|)) ds over t > 0 (and t < 0 without shadowing, negative weight)."""
     dtype, device = g.ct.dtype, g.ct.device
-    xg, wg = _nodes("gl", q.outer, dtype, device)
-    zh, wh = _nodes("gh", q.hermite, dtype, device)
+    xg, wg = gauss_nodes("gl", q.outer, dtype, device)
+    zh, wh = gauss_nodes("gh", q.hermite, dtype, device)
     K = float(q.width)
     a = g.st * g.su
     e = g.ct + g.st * g.mu  # the mean of t
@@ -246,20 +103,20 @@ def _emissivity_numerator(
     for lo, hi in panels:
         half = 0.5 * (hi - lo)
         x = (0.5 * (hi + lo))[:, None] + half[:, None] * xg  # (m, no)
-        W = half[:, None] * wg * _phi(x)
+        W = half[:, None] * wg * normal_pdf(x)
         du = g.su[:, None] * x
         u = g.mu[:, None] + du
         t = g.ct[:, None] + g.st[:, None] * u
         v = (g.mv[:, None] + g.kappa[:, None] * du)[..., None] + g.tau[:, None, None] * zh  # (m, no, nh)
         cos_o = t.abs()[..., None] * torch.rsqrt(1.0 + u[..., None] ** 2 + v * v)
-        es, ep = _fresnel_terms(cos_o.clamp_max(1.0), n_, k_, emission=True)
+        es, ep = fresnel_terms(cos_o.clamp_max(1.0), n_, k_, emission=True)
         e = (0.5 * (es + ep) * wh).sum(-1)
         total = total + (W * t * e).sum(-1)
     return total
 
 
 def _sky_numerator(
-    g: _Geom,
+    g: FacetGeometry,
     n: torch.Tensor,
     k: torch.Tensor,
     sky: Callable[[torch.Tensor], torch.Tensor],
@@ -272,10 +129,51 @@ def _sky_numerator(
     sea, R_B, which the form R_B (1 − T_ρ) + T_s then takes care of)."""
     dtype, device = g.ct.dtype, g.ct.device
     tiny = torch.finfo(dtype).tiny
-    xo, wo = _nodes("gl", q.outer, dtype, device)
-    xi, wi = _nodes("gl", q.inner, dtype, device)
+    xo, wo = gauss_nodes("gl", q.outer, dtype, device)
+    xi, wi = gauss_nodes("gl", q.inner, dtype, device)
     K = float(q.width)
     ct, st, su = g.ct, g.st, g.su
+    mu, mv = g.mu, g.mv
+    lo, hi, psi0 = _sky_panels(g, K, split, tiny)
+    half = (0.5 * (hi - lo))[..., None]  # (m, P, 1)
+    delta = ((0.5 * (hi + lo))[..., None] + half * xo).flatten(1)  # (m, P·no)
+    wdelta = (half * wo).flatten(1)
+    inv_ct = (1.0 / ct)[:, None]
+    u = 2.0 * inv_ct * torch.sin(psi0[:, None] + 0.5 * delta) * torch.sin(0.5 * delta)
+    h = (inv_ct * torch.sin(psi0[:, None] + delta)).clamp_min(0.0)  # half-chord = du/dψ
+    x = (u - mu[:, None]) / su[:, None]
+    W = wdelta * h * normal_pdf(x) / su[:, None]
+    t = ct[:, None] + st[:, None] * u
+    c = mv[:, None] + g.kappa[:, None] * (u - mu[:, None])
+    tau = g.tau[:, None]
+    z_lo = ((-h - c) / tau).clamp(-K, K)
+    z_hi = ((h - c) / tau).clamp(-K, K)
+    zh = 0.5 * (z_hi - z_lo)
+    z = (0.5 * (z_hi + z_lo))[..., None] + zh[..., None] * xi  # (m, P·no, ni)
+    Wz = zh[..., None] * wi * normal_pdf(z)
+    v = c[..., None] + tau[..., None] * z
+    inv = 1.0 / (1.0 + u[..., None] ** 2 + v * v)
+    cos_o = (t[..., None] * torch.sqrt(inv)).clamp(0.0, 1.0)
+    hh = h[..., None]
+    cos_r = (ct[:, None, None] * (hh - v) * (hh + v) * inv).clamp(0.0, 1.0)
+    rs, rp = fresnel_terms(cos_o, n[:, None, None], k[:, None, None])
+    m = cos_r.shape[0]
+    radiance = sky(cos_r.reshape(m, -1)).reshape(cos_r.shape)
+    w_rho = Wz * 0.5 * (rs + rp)
+    if masking:
+        w_rho = w_rho / (1.0 + _reflected_ray_lambda(g, u, v, t, inv, cos_r, tiny))
+    wt = W * t
+    return (wt * (w_rho * radiance).sum(-1)).sum(-1), (wt * w_rho.sum(-1)).sum(-1)
+
+
+def _sky_panels(g: FacetGeometry, K: float, split: bool, tiny: float
+                ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The outer panels of the sky integral in δ = ψ − ψ₀ (ψ the polar angle about the sky disc's
+    centre, ψ₀ its value at u = 0): (lo, hi) of shape (m, P), P = 3 with ``split`` else 1, and ψ₀.
+    The Gaussian window [m∥ − Kσ∥, m∥ + Kσ∥] is cut to the disc, and with ``split`` the panel is also
+    split where the Gaussian ridge leaves the disc."""
+    ct, st, su = g.ct, g.st, g.su
+    mu, mv = g.mu, g.mv
     alpha = ct / (1.0 + st)  # −u at the near edge of the disc
     B = ct * torch.rsqrt(2.0 * (1.0 + st))  # sin(ψ₀/2)
     psi0 = 2.0 * torch.asin(B)
@@ -289,7 +187,6 @@ def _sky_numerator(
         return _asin2(d / (A * sqrt_1mB2 + B * C))
 
     u_far = (1.0 + st) / ct
-    mu, mv = g.mu, g.mv
     u_lo = torch.maximum(-alpha, mu - K * su)
     u_hi = torch.minimum(u_far, mu + K * su)
     # At the disc's own edges the angle is exact (ψ = 0, π): shift() would take the square root of
@@ -321,51 +218,30 @@ def _sky_numerator(
         panels = [(d_lo, d_hi)]
     lo = torch.stack([a for a, _ in panels], -1)  # (m, P)
     hi = torch.stack([b for _, b in panels], -1)
-    half = (0.5 * (hi - lo))[..., None]  # (m, P, 1)
-    delta = ((0.5 * (hi + lo))[..., None] + half * xo).flatten(1)  # (m, P·no)
-    wdelta = (half * wo).flatten(1)
-    inv_ct = (1.0 / ct)[:, None]
-    u = 2.0 * inv_ct * torch.sin(psi0[:, None] + 0.5 * delta) * torch.sin(0.5 * delta)
-    h = (inv_ct * torch.sin(psi0[:, None] + delta)).clamp_min(0.0)  # half-chord = du/dψ
-    x = (u - mu[:, None]) / su[:, None]
-    W = wdelta * h * _phi(x) / su[:, None]
-    t = ct[:, None] + st[:, None] * u
-    c = mv[:, None] + g.kappa[:, None] * (u - mu[:, None])
-    tau = g.tau[:, None]
-    z_lo = ((-h - c) / tau).clamp(-K, K)
-    z_hi = ((h - c) / tau).clamp(-K, K)
-    zh = 0.5 * (z_hi - z_lo)
-    z = (0.5 * (z_hi + z_lo))[..., None] + zh[..., None] * xi  # (m, P·no, ni)
-    Wz = zh[..., None] * wi * _phi(z)
-    v = c[..., None] + tau[..., None] * z
-    inv = 1.0 / (1.0 + u[..., None] ** 2 + v * v)
-    cos_o = (t[..., None] * torch.sqrt(inv)).clamp(0.0, 1.0)
-    hh = h[..., None]
-    cos_r = (ct[:, None, None] * (hh - v) * (hh + v) * inv).clamp(0.0, 1.0)
-    rs, rp = _fresnel_terms(cos_o, n[:, None, None], k[:, None, None])
-    m = cos_r.shape[0]
-    radiance = sky(cos_r.reshape(m, -1)).reshape(cos_r.shape)
-    w_rho = Wz * 0.5 * (rs + rp)
-    if masking:
-        # the reflected ray r = 2 (n·v) n − v in the view frame (u along the view, v across), and the
-        # rms slope of the law along r's azimuth: Λ = [φ(μ) − μ (1 − Φ(μ))]/μ, μ = cot θ'/σ(r)
-        uu = u[..., None]
-        rx = 2.0 * t[..., None] * uu * inv - st[:, None, None]
-        ry = 2.0 * t[..., None] * v * inv
-        rh2 = (rx * rx + ry * ry).clamp_min(tiny)
-        su2 = (su * su)[:, None, None]
-        kap, tau2 = g.kappa[:, None, None], (g.tau * g.tau)[:, None, None]
-        s2 = (su2 * rx * rx + 2.0 * kap * su2 * rx * ry + (tau2 + kap * kap * su2) * ry * ry) / rh2
-        mu_r = cos_r / torch.sqrt(rh2 * s2.clamp_min(tiny))
-        mu_c = mu_r.clamp_min(1e-6)
-        lam = (_phi(mu_c) - mu_c * _Phi(-mu_c)) / mu_c
-        w_rho = w_rho / (1.0 + lam)
-    wt = W * t
-    return (wt * (w_rho * radiance).sum(-1)).sum(-1), (wt * w_rho.sum(-1)).sum(-1)
+    return lo, hi, psi0
+
+
+def _reflected_ray_lambda(g: FacetGeometry, u: torch.Tensor, v: torch.Tensor, t: torch.Tensor, inv: torch.Tensor,
+                          cos_r: torch.Tensor, tiny: float) -> torch.Tensor:
+    """Smith's Λ of the reflected ray at the sky integral's nodes (facet slopes u, v in the view frame,
+    t = cos Ω / cos θ, inv = 1/(1 + |s|²), cos θ' = ``cos_r``): G1 = 1/(1 + Λ)."""
+    st, su = g.st, g.su
+    # the reflected ray r = 2 (n·v) n − v in the view frame (u along the view, v across), and the
+    # rms slope of the law along r's azimuth: Λ = [φ(μ) − μ (1 − Φ(μ))]/μ, μ = cot θ'/σ(r)
+    uu = u[..., None]
+    rx = 2.0 * t[..., None] * uu * inv - st[:, None, None]
+    ry = 2.0 * t[..., None] * v * inv
+    rh2 = (rx * rx + ry * ry).clamp_min(tiny)
+    su2 = (su * su)[:, None, None]
+    kap, tau2 = g.kappa[:, None, None], (g.tau * g.tau)[:, None, None]
+    s2 = (su2 * rx * rx + 2.0 * kap * su2 * rx * ry + (tau2 + kap * kap * su2) * ry * ry) / rh2
+    mu_r = cos_r / torch.sqrt(rh2 * s2.clamp_min(tiny))
+    mu_c = mu_r.clamp_min(1e-6)
+    return (normal_pdf(mu_c) - mu_c * normal_cdf(-mu_c)) / mu_c
 
 
 def _sky_terms(
-    g: _Geom,
+    g: FacetGeometry,
     n: torch.Tensor,
     k: torch.Tensor,
     sky_fn: Callable,
@@ -409,16 +285,6 @@ def _sky_terms(
 # -- argument handling -----------------------------------------------------------------------
 
 
-def _check_angles(view_zenith: Any, view_azimuth: Any) -> None:
-    check_finite_range("view_zenith", view_zenith, 0.0, math.pi / 2 + 1e-6, unit="rad")
-    check_finite_range("view_azimuth", view_azimuth, unit="rad")
-
-
-def _check_slopes(slopes: Any) -> None:
-    if not isinstance(slopes, SlopeStatistics):
-        raise ValueError(f"slopes must be a roughsea_torch.SlopeStatistics; got {type(slopes).__name__}")
-
-
 def _sky_batch_shape(sky: Any) -> tuple[int, ...]:
     if isinstance(sky, TabulatedSky):
         return tuple(sky.radiance.shape[:-1])
@@ -458,24 +324,6 @@ def _run_chunked(
     return torch.cat(parts).reshape(batch_shape)
 
 
-def _prepare(view_zenith, view_azimuth, slopes, refractive_index=None, **extra):
-    _check_slopes(slopes)
-    tensors = dict(view_zenith=view_zenith, view_azimuth=view_azimuth, **slopes.parameters_dict())
-    if refractive_index is not None:
-        tensors["refractive_index"] = refractive_index
-    tensors.update({k: v for k, v in extra.items() if isinstance(v, torch.Tensor)})
-    dtype, device = resolve_dtype_device(**tensors)  # device mismatch is reported first
-    _check_angles(view_zenith, view_azimuth)
-    vz = as_tensor(view_zenith, dtype, device)
-    va = as_tensor(view_azimuth, dtype, device)
-    vx, vy, cxy = slopes.tensors(dtype, device)
-    if slopes.has_mean:
-        mx, my = slopes.mean_tensors(dtype, device)
-        vx, vy, cxy = (t + 0 * (mx + my) for t in (vx, vy, cxy))  # the mean's batch shape joins
-        return dtype, device, vz, va, vx, vy, cxy, mx, my
-    return dtype, device, vz, va, vx, vy, cxy, None, None
-
-
 # -- public functions ------------------------------------------------------------------------
 
 
@@ -492,16 +340,16 @@ def projected_area(view_zenith: Any, view_azimuth: Any, slopes: SlopeStatistics,
         D [dimensionless]: cos θ̂ Φ(μ) + sin θ̂ σ∥ φ(μ) with μ = cot θ̂/σ∥ (= cos θ̂ (1 + Λ), Smith's
         shadowing function Λ), or cos θ̂ without shadowing (Eq. 7).
     """
-    _, _, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes)
-    return _denominator(_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
+    _, _, vz, va, vx, vy, cxy, mx, my = prepare_inputs(view_zenith, view_azimuth, slopes)
+    return denominator(facet_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
 
 
 def smith_lambda(view_zenith: Any, view_azimuth: Any, slopes: SlopeStatistics) -> torch.Tensor:
     """Smith's (1967) Λ = D / cos θ̂ − 1: the fraction of LOS-projected area added by facets that
     face the sensor beyond the horizontal projection [dimensionless]. Diverges as θ̂ → 90°."""
-    _, _, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes)
-    g = _geometry(vz, va, vx, vy, cxy, mx, my)
-    return _denominator(g, True) / g.ct - 1.0
+    _, _, vz, va, vx, vy, cxy, mx, my = prepare_inputs(view_zenith, view_azimuth, slopes)
+    g = facet_geometry(vz, va, vx, vy, cxy, mx, my)
+    return denominator(g, True) / g.ct - 1.0
 
 
 def emissivity(
@@ -531,15 +379,15 @@ def emissivity(
         >>> round(float(emissivity(0.0, 0.0, s, 1.218 + 0.0508j)), 4)
         0.9898
     """
-    dtype, device, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes, refractive_index)
+    dtype, device, vz, va, vx, vy, cxy, mx, my = prepare_inputs(view_zenith, view_azimuth, slopes, refractive_index)
     n, k = split_refractive_index(refractive_index, dtype, device)
     q = quadrature or Quadrature.default(dtype)
     shape = torch.broadcast_shapes(vz.shape, va.shape, vx.shape, vy.shape, cxy.shape, n.shape, k.shape)
     work = _work_dtype(dtype, shadowing)
     vz, va, vx, vy, cxy, n, k = (t.to(work) for t in (vz, va, vx, vy, cxy, n, k))
     mx, my = (None if t is None else t.to(work) for t in (mx, my))
-    g = _geometry(vz, va, vx, vy, cxy, mx, my).flat(shape)
-    D = _denominator(g, shadowing)
+    g = facet_geometry(vz, va, vx, vy, cxy, mx, my).flat(shape)
+    D = denominator(g, shadowing)
     nf, kf = n.expand(shape).reshape(-1), k.expand(shape).reshape(-1)
     points = q.outer * q.hermite * (1 if shadowing else 2)
 
@@ -556,8 +404,8 @@ def _work_dtype(dtype: torch.dtype, shadowing: bool) -> torch.dtype:
     positive one: near grazing ε̄ ~ cos θ̂ while each part is ~σ∥, a condition number ~σ∥ tan θ̂
     (10³ at 89.99°); and R_a = R_B (1 − T_ρ) + T_s with T_ρ, T_s/R_B ~ σ∥/cos θ̂ ≫ 1 cancel to
     R_B + O(1). Both are computed in float64 whatever the dtype, and the result is rounded once
-    (in float32 they reached 1e-4 at θ̂ ≥ 89.9999°, ``pipelines/stability.py``). With shadowing
-    (T_ρ ≤ 1, ε̄ a mean of positive terms) the dtype itself is used.
+    (the float32 errors this avoids: ``docs/notes/expectation.md``). With shadowing (T_ρ ≤ 1, ε̄ a
+    mean of positive terms) the dtype itself is used.
     """
     return torch.float64 if not shadowing else dtype
 
@@ -613,22 +461,17 @@ def apparent_radiance(
         directions each) and must act elementwise.
     """
     check_finite_range("sea_radiance", sea_radiance, 0.0, unit="W m-2 sr-1")
-    t_s, t_rho, dtype = _reflection_terms(
+    t_s, t_rho, dtype = _reflection_integrals(
         view_zenith, view_azimuth, slopes, refractive_index, sky, shadowing, quadrature, dict(sea_radiance=sea_radiance),
         sky_masking,
     )
     rb = as_tensor(sea_radiance, dtype, t_s.device).to(t_s.dtype)
     out = (rb - rb * t_rho + t_s).to(dtype)
     if sun is not None:
-        from .sun import Sun, glint_radiance
-
         if not isinstance(sun, Sun):
             raise ValueError(f"sun must be None or a roughsea_torch.Sun; got {type(sun).__name__}")
         out = out + glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun, shadowing, sun_masking)
     if foam_fraction is not None:
-        from .foam import foam_radiance, sky_hemispherical_mean, with_foam
-        from .radiometry import LWIR
-
         check_finite_range("foam_fraction", foam_fraction, 0.0, 1.0)
         e_sky = sky_hemispherical_mean(as_sky(sky), dtype=out.dtype, device=out.device)
         rf = foam_radiance(as_tensor(view_zenith, out.dtype, out.device), LWIR, rb.to(out.dtype), e_sky,
@@ -645,7 +488,9 @@ def reflection_terms(
     sky: Any = None,
     shadowing: bool = True,
     quadrature: Quadrature | None = None,
-    _extra: dict | None = None,
+    *,
+    sky_masking: bool = False,
+    working_dtype: bool = False,
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """The two sky-reflection integrals of Eq. 10: R_a = R_B (1 − T_ρ) + T_s.
 
@@ -654,14 +499,22 @@ def reflection_terms(
     the sky radiance. Both are independent of the sea temperature, so a renderer can tabulate them
     once per sea state and apply R_B per pixel. Arguments as :func:`apparent_radiance`.
 
+    Returns:
+        (T_s, T_ρ), the broadcast shape of the inputs (including a batched sky's leading dims), in the
+        inputs' dtype; with ``working_dtype=True`` in the dtype they are accumulated in instead
+        (float64 without shadowing, :func:`_work_dtype`; the inputs' dtype with shadowing).
+
     Without shadowing T_ρ and T_s/R_B grow like σ∥/cos θ̂ near grazing and R_B (1 − T_ρ) + T_s
-    cancels them: combine them in float64 there (``apparent_radiance`` does).
+    cancels them: combine them in float64 there (``working_dtype=True``; ``apparent_radiance`` does).
     """
-    t_s, t_rho, dtype = _reflection_terms(view_zenith, view_azimuth, slopes, refractive_index, sky, shadowing, quadrature, _extra)
+    t_s, t_rho, dtype = _reflection_integrals(view_zenith, view_azimuth, slopes, refractive_index, sky, shadowing,
+                                              quadrature, None, sky_masking)
+    if working_dtype:
+        return t_s, t_rho
     return t_s.to(dtype), t_rho.to(dtype)
 
 
-def _reflection_terms(
+def _reflection_integrals(
     view_zenith: Any,
     view_azimuth: Any,
     slopes: SlopeStatistics,
@@ -669,14 +522,15 @@ def _reflection_terms(
     sky: Any,
     shadowing: bool,
     quadrature: Quadrature | None,
-    _extra: dict | None,
+    extra_tensors: dict | None,
     sky_masking: bool = False,
 ) -> tuple[torch.Tensor, torch.Tensor, torch.dtype]:
-    """(T_s, T_ρ) in the working dtype (:func:`_work_dtype`), and the call's dtype."""
+    """(T_s, T_ρ) in the working dtype (:func:`_work_dtype`), and the call's dtype; the tensors among
+    ``extra_tensors`` (``apparent_radiance``'s sea radiance) join the dtype and device resolution."""
     sky_fn = as_sky(sky)
     sky_tensor = sky_fn.radiance if isinstance(sky_fn, (TabulatedSky, ConstantSky)) else None
-    extra = {k: v for k, v in (_extra or {}).items() if isinstance(v, torch.Tensor)}
-    dtype, device, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes, refractive_index, **extra)
+    extra = {k: v for k, v in (extra_tensors or {}).items() if isinstance(v, torch.Tensor)}
+    dtype, device, vz, va, vx, vy, cxy, mx, my = prepare_inputs(view_zenith, view_azimuth, slopes, refractive_index, **extra)
     if isinstance(sky_tensor, torch.Tensor):  # a sky table follows the call's dtype; only its device must match
         check_same_device(view_zenith=vz, sky=sky_tensor)
     n, k = split_refractive_index(refractive_index, dtype, device)
@@ -687,11 +541,12 @@ def _reflection_terms(
     work = _work_dtype(dtype, shadowing)
     vz, va, vx, vy, cxy, n, k = (t.to(work) for t in (vz, va, vx, vy, cxy, n, k))
     mx, my = (None if t is None else t.to(work) for t in (mx, my))
-    g = _geometry(vz, va, vx, vy, cxy, mx, my).flat(shape)
+    g = facet_geometry(vz, va, vx, vy, cxy, mx, my).flat(shape)
     if g.ct.numel() == 0:
         z = torch.zeros(shape, dtype=work, device=device)
         return z, z, dtype
-    D = _denominator(g, shadowing)
+    D = denominator(g, shadowing)
     nf, kf = n.expand(shape).reshape(-1), k.expand(shape).reshape(-1)
     t_s, t_rho = _sky_terms(g, nf, kf, sky_fn, shape, D, q, sky_masking)
     return t_s.reshape(shape), t_rho.reshape(shape), dtype
+

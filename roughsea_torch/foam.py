@@ -1,6 +1,6 @@
 """Foam (whitecaps): coverage against wind, foam emissivity, foam radiance and the area mixture.
 
-In the mean model (``docs/waves.md`` §6) foam is an area fraction ``f`` of the sea. A pixel sees
+In the mean model (``docs/physics.md`` §12) foam is an area fraction ``f`` of the sea. A pixel sees
 
     R = (1 − f) R_a + f R_foam                                          (:func:`with_foam`)
 
@@ -56,7 +56,7 @@ Foam emissivity (:func:`foam_emissivity`), thermal infrared, a measurement:
     for bands centred in 2.5–6 µm); pass ``refractive_index`` (e.g. from
     :func:`~roughsea_torch.optics.band_refractive_index`) to use the one given to Eq. 10.
 
-In a textured image (``docs/waves.md`` §6) foam sits on the breaking crests:
+In a textured image (``docs/texture.md`` §8) foam sits on the breaking crests:
 :func:`crest_foam_fraction` gives each pixel its own fraction f_pix from the resolved crest
 variable of the :class:`~roughsea_torch.waves.WaveField`, with E[f_pix] = W exactly and
 f_pix = W where the footprint resolves no wave; the pixel is then (1 − f_pix) R_a + f_pix R_foam.
@@ -70,14 +70,15 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import torch
 
 from ._validation import as_tensor, check_finite_range, resolve_dtype_device
+from .atmosphere import as_sky
 from .optics import fresnel_emissivity
-from .radiometry import LWIR, MWIR, as_band
+from .radiometry import LWIR, as_band
 
 __all__ = [
     "MONAHAN_COEFFICIENT",
@@ -90,6 +91,7 @@ __all__ = [
     "with_foam",
     "CREST_FOAM_FLOOR",
     "crest_foam_fraction",
+    "crest_fraction_from_variances",
 ]
 
 MONAHAN_COEFFICIENT = 3.84e-6  # Monahan & O'Muircheartaigh 1980, W = a U10^b (fraction, U10 in m/s)
@@ -235,7 +237,7 @@ def sky_hemispherical_mean(
     Args:
         sky: R_s as a callable of cos(zenith) (receives a tensor of shape (n,), returns (..., n)),
             a constant (float or tensor, returned as is: its mean is itself), or any form
-            :func:`~roughsea_torch.sky.as_sky` accepts (table, named atmosphere).
+            :func:`~roughsea_torch.atmosphere.as_sky` accepts (table, named atmosphere).
         n: number of nodes, ≥ 1.
         dtype, device: of the nodes given to a callable sky (default ``torch.get_default_dtype()``
             and CPU); for a float constant, of the result.
@@ -255,8 +257,6 @@ def sky_hemispherical_mean(
     if sky is None:
         raise ValueError("sky is required: a callable of cos(zenith), a (zenith, radiance) table or a constant")
     if not callable(sky):
-        from .sky import as_sky
-
         sky = as_sky(sky)
     dt = dtype if dtype is not None else torch.get_default_dtype()
     if dt not in (torch.float32, torch.float64):
@@ -295,7 +295,7 @@ def with_foam(apparent_radiance: Any, foam_fraction: Any, foam_radiance: Any) ->
     return (1.0 - f) * ra + f * rf
 
 
-def crest_foam_fraction(
+def crest_foam_fraction(  # ~80 lines for its docstring (the derivation of the exact mean); the code is 15
     crest: Any,
     resolved_variance: Any,
     total_variance: Any,
@@ -317,33 +317,29 @@ def crest_foam_fraction(
     Φ the standard normal distribution function, W the whitecap fraction (Monahan &
     O'Muircheartaigh 1980, :func:`whitecap_fraction`), ρ = ``floor``.
 
-    Exact mean. For X_r ~ N(0, σ_r²) and Z ~ N(0, 1) independent,
-    E[Φ((X_r − c)/σ_u)] = P(X_r + σ_u Z > c) = P(N(0, σ_r² + σ_u²) > c) = Φ(−Φ⁻¹(1 − W)) = W,
-    whatever σ_u: the floor ρ and the position-averaged variances only shape the pattern, never
-    the ensemble mean (c is taken with the same σ_r² + σ_u²). Far field: σ_r = 0, X_r = 0 give
-    f_pix = Φ(−Φ⁻¹(1 − W)) = W, the uniform-fraction image. Only a σ_r² that is not the true variance
-    of X_r at the point moves the mean: with :meth:`WaveField.crest_variance` (a position average)
-    the bilinear interpolation of the band tiles leaves a texel-scale ripple of the point variance
-    (``waves.WaveField``, *Evaluation*) that averages out over positions.
+    Exact mean. For X_r ~ N(0, σ_r²) and Z ~ N(0, 1) independent, E[Φ((X_r − c)/σ_u)] =
+    P(X_r + σ_u Z > c) = P(N(0, σ_r² + σ_u²) > c) = Φ(−Φ⁻¹(1 − W)) = W, whatever σ_u: the floor ρ and
+    the position-averaged variances only shape the pattern, never the ensemble mean (c is taken with
+    the same σ_r² + σ_u²). Far field: σ_r = 0, X_r = 0 give f_pix = W, the uniform-fraction image.
+    Only a σ_r² that is not the true variance of X_r at the point moves the mean:
+    :meth:`WaveField.crest_variance` is a position average, and the texel-scale ripple of the point
+    variance about it averages out over positions.
 
     No bias of the slope texture. Each Fourier component's X is in phase with its elevation and its
     slope in quadrature, so X_r and the resolved slope at a point are uncorrelated, hence (Gaussian)
     independent: the foam mixture leaves the ensemble mean of the slope-driven texture unchanged,
     E[(1 − f_pix) T] = (1 − W) E[T].
 
-    Which crest. X is the :class:`~roughsea_torch.waves.WaveField`'s crest variable
-    (``sample(..., crest=True)``, :meth:`~roughsea_torch.waves.WaveField.crest_variance`): the
-    downward vertical acceleration −a_z/g of the waves from the spectral peak to about ten times
-    its wavenumber (see there for the sources and the reasons). The construction itself holds for
-    any zero-mean Gaussian field: the elevation η (``sample(..., elevation=True)``,
-    :meth:`~roughsea_torch.waves.WaveField.elevation_variance`) puts the foam on the tops of the
-    highest (dominant) crests instead.
+    Which crest. X is the :class:`~roughsea_torch.waves.WaveField`'s crest variable (``sample(...,
+    crest=True)``): the downward vertical acceleration −a_z/g of the waves from the spectral peak to
+    about ten times its wavenumber (sources there). Any zero-mean Gaussian field works: the elevation
+    η puts the foam on the tops of the highest (dominant) crests instead.
 
-    Degenerate ends. W = 0 gives exactly 0 (below W = 1e-30, f_pix is the value at 1e-30 scaled
-    by W/1e-30, which keeps the mean exact and the gradient finite); W = 1 gives exactly 1 (W is
-    ≤ 0.3 where Monahan's law holds); σ_X² = 0 (a field without crest variance) gives f_pix = W;
-    σ_u → 0 (a footprint that resolves every band) would make f_pix a step in X_r: the floor ρ keeps
-    σ_u ≥ ρ σ_X (default 0.05, an edge 0.1 σ_X wide), so f_pix and its gradients stay finite.
+    Degenerate ends. W = 0 gives exactly 0 (below W = 1e-30, f_pix is the value at 1e-30 scaled by
+    W/1e-30: the mean stays exact, the gradient finite); W = 1 gives exactly 1; σ_X² = 0 (a field
+    without crest variance) gives f_pix = W; σ_u → 0 (a footprint that resolves every band) would make
+    f_pix a step in X_r: the floor ρ keeps σ_u ≥ ρ σ_X (default 0.05, an edge 0.1 σ_X wide), so f_pix
+    and its gradients stay finite.
 
     Args:
         crest: X_r, the pixel's resolved crest variable (or elevation [m]), any shape.
@@ -381,12 +377,14 @@ def crest_foam_fraction(
     v_r = as_tensor(resolved_variance, dtype, device)
     v_t = as_tensor(total_variance, dtype, device)
     w = as_tensor(whitecap_fraction, dtype, device)
-    return _crest_foam_fraction(x, v_r, v_t, w, floor)
+    return crest_fraction_from_variances(x, v_r, v_t, w, floor)
 
 
-def _crest_foam_fraction(x: torch.Tensor, v_r: torch.Tensor, v_t: torch.Tensor, w: torch.Tensor,
-                         floor: float = CREST_FOAM_FLOOR) -> torch.Tensor:
-    """:func:`crest_foam_fraction` on tensors already checked (the renderer's, per pixel)."""
+def crest_fraction_from_variances(x: torch.Tensor, v_r: torch.Tensor, v_t: torch.Tensor, w: torch.Tensor,
+                                  floor: float = CREST_FOAM_FLOOR) -> torch.Tensor:
+    """:func:`crest_foam_fraction` on tensors already checked (the renderer's, per pixel): the crest
+    variable X_r (``x``), its resolved and total variances σ_r², σ_X² (``v_r``, ``v_t``) and the
+    whitecap fraction W (``w``), of one dtype and device, broadcasting together."""
     v_u = torch.clamp(v_t - v_r, min=0.0) + (floor * floor) * v_t
     known = v_u > 0  # False only without crest variance at all (or ρ = 0 and nothing unresolved)
     v_u = torch.where(known, v_u, torch.ones_like(v_u))
@@ -398,3 +396,4 @@ def _crest_foam_fraction(x: torch.Tensor, v_r: torch.Tensor, v_t: torch.Tensor, 
     f = torch.where(w < _W_MIN, f * (w / _W_MIN), f)  # exactly 0 at W = 0, mean still W
     f = torch.where(known, f, w)
     return torch.where(inner, f, torch.ones_like(f))
+

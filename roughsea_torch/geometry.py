@@ -1,6 +1,6 @@
 """Cameras (kornia ``PinholeCamera``) and per-pixel view geometry over a spherical or flat sea.
 
-Conventions (``docs/physics.md`` §2, §8): world frame right-handed, z up, origin at sea level under
+Conventions (``docs/physics.md`` §2, §9): world frame right-handed, z up, origin at sea level under
 the sensor; azimuths from +x towards +y. Camera extrinsics are world → camera with OpenCV axes
 (x right, y down, z forward), pixel centres at integer coordinates (kornia's convention). The sea is
 a sphere of radius ``earth_radius_m`` centred at (0, 0, −R) (``float('inf')``: the plane z = 0).

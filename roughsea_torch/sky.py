@@ -6,20 +6,22 @@ Three forms are accepted wherever a ``sky`` argument appears:
 - a table: a :class:`TabulatedSky`, or a pair ``(zenith [rad], radiance)`` of 1-d arrays/tensors;
 - a constant: a float, or a tensor broadcastable against the batch of view directions.
 
-Named atmospheres (LOWTRAN7 tables) come from :func:`roughsea_torch.atmosphere.load_sky`.
+Named atmospheres (LOWTRAN7 tables) come from :func:`roughsea_torch.atmosphere.load_sky`, and
+:func:`roughsea_torch.atmosphere.as_sky` turns any of these forms (or an atmosphere's name) into a
+callable; this module stays below the atmospheres and never imports them.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import torch
 
 from ._lookup import bucket_grid, next_nodes
 
-__all__ = ["TabulatedSky", "ConstantSky", "as_sky", "select_sky", "pchip_derivatives"]
+__all__ = ["TabulatedSky", "ConstantSky", "select_sky", "pchip_derivatives"]
 
 
 def pchip_derivatives(x: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
@@ -175,8 +177,6 @@ class ConstantSky:
         return f"ConstantSky({self.radiance!r})"
 
 
-
-
 def select_sky(sky: Any, index: Any) -> Any:
     """The sky of some sea states: rows ``index`` of a batched table or constant whose leading dim
     runs over the (flattened) batch; a shared sky is returned as it is."""
@@ -185,25 +185,3 @@ def select_sky(sky: Any, index: Any) -> Any:
     if isinstance(sky, ConstantSky) and torch.as_tensor(sky.radiance).ndim > 0:
         return ConstantSky(torch.as_tensor(sky.radiance)[index])
     return sky
-
-
-def as_sky(sky: Any) -> Callable[[torch.Tensor], torch.Tensor]:
-    """Normalize any accepted ``sky`` form to a callable of cos(zenith)."""
-    if sky is None:
-        raise ValueError("sky is required: a callable of cos(zenith), a (zenith, radiance) table or a constant")
-    if isinstance(sky, str):
-        from .atmosphere import load_sky  # named LOWTRAN atmosphere, default band
-
-        return load_sky(sky)
-    if isinstance(sky, (TabulatedSky, ConstantSky)):
-        return sky
-    if isinstance(sky, (tuple, list)) and len(sky) == 2:
-        return TabulatedSky(*sky)
-    if isinstance(sky, (int, float)) or isinstance(sky, (torch.Tensor, np.ndarray)):
-        val = torch.as_tensor(sky)
-        if torch.isnan(val).any() or (val < 0).any():
-            raise ValueError("sky: a constant sky radiance must be finite and >= 0 (W m-2 sr-1)")
-        return ConstantSky(sky)
-    if callable(sky):
-        return sky
-    raise ValueError(f"sky: unsupported type {type(sky).__name__}")

@@ -58,7 +58,7 @@ class SlopeStatistics:
     def shifted(self, mean_upwind: Any, mean_crosswind: Any = 0.0) -> SlopeStatistics:
         """The same covariance about a non-zero mean slope μ = (μ_up, μ_cross) [dimensionless].
 
-        The two-scale sea (``docs/waves.md`` §2): under a resolved wave that tilts the surface by
+        The two-scale sea (``docs/texture.md`` §5): under a resolved wave that tilts the surface by
         μ, the unresolved slopes are N(s; μ, Σ_u) in the world (upwind, crosswind) frame, while the
         sky stays in the world frame. Every function of the model accepts such statistics (the
         facet weight of Eq. 5 and its denominator D are taken over the shifted density).

@@ -15,8 +15,8 @@ observer at 0 km looking at the sun along a refracted path to space, mean Sun–
 LOWTRAN's extraterrestrial solar spectrum (the same, without the atmosphere). Not included by
 default: aerosol extinction (which dims the direct beam further, most in MWIR; optional with
 ``load_solar_irradiance(..., aerosol="maritime")``, LOWTRAN's aerosol transmittance from
-``solar_direct_aerosol.npz``) and the sunlight scattered into the rest of the sky
-(:mod:`roughsea_torch.daysky`).
+``solar_direct_aerosol.npz``, :func:`direct_aerosol_transmittance`) and the sunlight scattered
+into the rest of the sky (:mod:`roughsea_torch.daysky`, which builds on this module).
 
 The zenith angle is the *apparent* one (refracted, as seen from the sea); pvlib's
 ``apparent_zenith`` (what :func:`sun_position` returns). The two differ by ≤ 0.1° above 80° and by
@@ -41,6 +41,10 @@ from typing import Any
 import numpy as np
 import torch
 
+from ._tables import (check_band_coverage, read_generated_table, read_table, table_dir, table_index,
+                      wavelength_coverage)
+from .lowtran import ATMOSPHERES as SOLAR_ATMOSPHERES  # the six LOWTRAN models, as for the sky
+from .lowtran import spectral_weights  # the same band integration as the sky tables
 from .radiometry import SpectralBand, as_band
 from .sky import pchip_derivatives
 from .sun import SUN_RADIUS
@@ -53,12 +57,13 @@ __all__ = [
     "solar_provenance",
     "air_mass",
     "sun_position",
+    "disk_fraction",
+    "direct_aerosol_transmittance",
+    "check_band",
 ]
 
-from .atmosphere import ATMOSPHERES as SOLAR_ATMOSPHERES  # the six LOWTRAN models, as for the sky
-from .atmosphere import _dir
-
 TABLE = "solar_direct.npz"
+DIRECT_AEROSOL_TABLE = "solar_direct_aerosol.npz"  # made by pipelines/lowtran_daysky.py with the day-sky aerosols
 _LOG_FLOOR = 1e-30  # band values below this fraction of the band's TOA value are held at it
 
 
@@ -73,29 +78,25 @@ def air_mass(zenith_deg: Any) -> Any:
 
 
 def _path(data_dir: str | Path | None) -> Path:
-    return _dir(data_dir) / TABLE
+    return table_dir(data_dir) / TABLE
 
 
-def _tables(data_dir: str | Path | None = None) -> dict[str, Any]:
-    from .atmosphere import _read  # one reader (read-only arrays, provenance parsed, cached) for every LOWTRAN table
-
+def solar_tables(data_dir: str | Path | None = None) -> dict[str, Any]:
+    """The solar direct-beam table (``solar_direct.npz``) as read (cached, read-only arrays)."""
     p = _path(data_dir)
     if not p.is_file():
         raise FileNotFoundError(f"no solar table at {p} (made by pipelines/lowtran_solar.py)")
-    return _read(str(p))
+    return read_table(str(p))
 
 
 def _index(atmosphere: Any, t: dict[str, Any]) -> int:
-    names = [str(n) for n in t["atmospheres"]]
-    if not isinstance(atmosphere, str) or atmosphere not in names:
-        raise ValueError(f"atmosphere: unknown atmosphere {atmosphere!r}; available: {', '.join(names)}")
-    return names.index(atmosphere)
+    return table_index("atmosphere", atmosphere, [str(n) for n in t["atmospheres"]])
 
 
 def solar_provenance(data_dir: str | Path | None = None) -> dict[str, Any]:
     """How the solar table was made: LOWTRAN version and settings, grids, date, command, and the
     interpolation errors measured at held-out sun zeniths (a copy; JSON-like dict)."""
-    return json.loads(json.dumps(_tables(data_dir)["provenance"]))
+    return json.loads(json.dumps(solar_tables(data_dir)["provenance"]))
 
 
 def load_solar_spectral(atmosphere: str, *, data_dir: str | Path | None = None) -> dict[str, np.ndarray]:
@@ -105,7 +106,7 @@ def load_solar_spectral(atmosphere: str, *, data_dir: str | Path | None = None) 
     ``direct_irradiance`` (Nz, Nν) [W m⁻² m⁻¹] at sea level, normal to the beam, and
     ``toa_irradiance`` (Nν,) [W m⁻² m⁻¹], LOWTRAN's extraterrestrial sun at 1 AU.
     """
-    t = _tables(data_dir)
+    t = solar_tables(data_dir)
     i = _index(atmosphere, t)
     nu = t["wavenumber_cm1"].astype(np.float64)
     return {"wavenumber_cm1": nu, "wavelength_m": 1e-2 / nu,
@@ -114,15 +115,12 @@ def load_solar_spectral(atmosphere: str, *, data_dir: str | Path | None = None) 
             "toa_irradiance": t["toa_irradiance"].astype(np.float64)}
 
 
-def _band(band: Any, response: Any, nu: np.ndarray) -> SpectralBand:
-    b = as_band(band, response)  # ValueError on malformed bands
-    lo, hi = float(1e-2 / nu.max()), float(1e-2 / nu.min())
-    if b.lo < lo * (1 - 1e-9) or b.hi > hi * (1 + 1e-9):
-        raise ValueError(
-            f"band: ({b.lo:.6g}, {b.hi:.6g}) m is outside the spectral coverage of the LOWTRAN solar "
-            f"table, [{lo:.6g}, {hi:.6g}] m ({lo * 1e6:.4f}-{hi * 1e6:.4f} um)"
-        )
-    return b
+def check_band(band: Any, response: Any, nu: np.ndarray) -> SpectralBand:
+    """The band checks of :func:`load_solar_irradiance` (and of the day sky,
+    :func:`roughsea_torch.daysky.load_scattered_sky`): the band (a ``SpectralBand``, or limits and a
+    response) if it lies within the wavelengths of the solar table's wavenumbers ``nu`` [cm⁻¹,
+    float64]; ``ValueError`` for a malformed band or one outside them (given in metres)."""
+    return check_band_coverage(as_band(band, response), wavelength_coverage(nu), "LOWTRAN solar table")
 
 
 class SolarIrradiance:
@@ -209,6 +207,33 @@ def disk_fraction(z: torch.Tensor) -> torch.Tensor:
     return torch.where(z >= half_pi + SUN_RADIUS, torch.zeros_like(frac), frac)
 
 
+def _aerosol_table(data_dir: str | Path | None = None) -> dict[str, Any]:
+    return read_generated_table(DIRECT_AEROSOL_TABLE, data_dir, "pipelines/lowtran_daysky.py")
+
+
+def direct_aerosol_transmittance(atmosphere: str, aerosol: str, *,
+                                 data_dir: str | Path | None = None) -> np.ndarray:
+    """The aerosol's transmittance of the direct solar beam, τ_aer = E(aerosol) / E(no aerosol),
+    as LOWTRAN7 computes them (``IEMSCT = 3``, sea level, apparent sun zenith), (Nz, Nν) float64 on
+    the nodes of ``solar_direct.npz`` (its ``sun_zenith_rad`` × ``wavenumber_cm1``), for the aerosols
+    of the day sky (:data:`roughsea_torch.daysky.AEROSOLS`).
+
+    Stored in ``solar_direct_aerosol.npz`` (made by ``pipelines/lowtran_daysky.py``) as log τ_aer
+    quantized to 2e-4 (differenced along wavenumber); where LOWTRAN's direct beam without aerosol is
+    ~0 (< 1e-30 of the sun above the atmosphere) the ratio is interpolated in wavenumber (it
+    multiplies ~0). Used by :func:`load_solar_irradiance` (``aerosol=``).
+    """
+    t = _aerosol_table(data_dir)
+    ia = table_index("atmosphere", atmosphere, [str(n) for n in t["atmospheres"]])
+    ib = table_index("aerosol", aerosol, [str(n) for n in t["aerosols"]])
+    z = solar_tables(data_dir)["sun_zenith_rad"]
+    if z.shape != t["sun_zenith_rad"].shape or np.any(z != t["sun_zenith_rad"]):
+        raise ValueError(f"{DIRECT_AEROSOL_TABLE} and solar_direct.npz in {table_dir(data_dir)} have different "
+                         "sun-zenith nodes")
+    log_tau = np.cumsum(t["log_transmittance_dq"][ia, ib].astype(np.int64), axis=-1) * float(t["log_transmittance_step"])
+    return np.exp(np.minimum(log_tau, 0.0))
+
+
 def load_solar_irradiance(
     atmosphere: str,
     band: Any,
@@ -231,7 +256,7 @@ def load_solar_irradiance(
         aerosol: None (default: the table as is, no aerosol) or one of
             :data:`roughsea_torch.daysky.AEROSOLS` (``"maritime"``, ``"rural"``, 23 km): the beam is
             also dimmed by that aerosol's transmittance, LOWTRAN7 ``IEMSCT = 3`` with ``IHAZE`` set
-            (:func:`roughsea_torch.daysky.direct_aerosol_transmittance`, applied per wavenumber and
+            (:func:`direct_aerosol_transmittance`, applied per wavenumber and
             sun-zenith node before the band integral), consistent with
             :func:`roughsea_torch.daysky.load_scattered_sky`'s aerosols.
 
@@ -245,22 +270,18 @@ def load_solar_irradiance(
         ValueError: unknown atmosphere or aerosol, a band outside the table's wavelengths, a bad
             response, dtype or distance.
     """
-    from .atmosphere import spectral_weights  # the same band integration as the sky tables
-
     if dtype not in (torch.float32, torch.float64):
         raise ValueError(f"dtype: must be torch.float32 or torch.float64, got {dtype!r}")
     if not (isinstance(distance_au, (int, float)) and 0.9 < float(distance_au) < 1.1):
         raise ValueError(f"distance_au: must be a number in (0.9, 1.1) AU, got {distance_au!r}")
-    t = _tables(data_dir)
+    t = solar_tables(data_dir)
     i = _index(atmosphere, t)
     nu = t["wavenumber_cm1"].astype(np.float64)
-    b = _band(band, response, nu)
+    b = check_band(band, response, nu)
     w = spectral_weights(1e-2 / nu, b)
     scale = 1.0 / float(distance_au) ** 2
     direct = t["direct_irradiance"][i].astype(np.float64)
     if aerosol is not None:
-        from .daysky import direct_aerosol_transmittance  # solar_direct_aerosol.npz, same nodes
-
         direct = direct * direct_aerosol_transmittance(atmosphere, aerosol, data_dir=data_dir)
     values = direct @ w * scale
     toa = float(t["toa_irradiance"].astype(np.float64) @ w) * scale

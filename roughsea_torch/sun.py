@@ -1,4 +1,4 @@
-"""The reflected sun (glint) in the facet-weighted expectation (``docs/waves.md`` §5).
+"""The reflected sun (glint) in the facet-weighted expectation (``docs/physics.md`` §10).
 
 The sun is a uniform disk of radiance L_sun = E_sun / Ω_sun, angular radius α (0.267°, Ω_sun =
 2π(1 − cos α) ≈ 6.8e-5 sr) and direction ω_sun. In Eq. 10 it replaces R_s(θ') on the facets whose
@@ -33,12 +33,14 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
 import torch
 
 from ._validation import as_tensor, check_finite_range
+from .facets import denominator, facet_geometry, prepare_inputs
+from .optics import fresnel_terms, split_refractive_index
+from .quadrature import gauss_nodes
 
-__all__ = ["Sun", "SUN_RADIUS", "glint_radiance", "sun_masking_factor"]
+__all__ = ["Sun", "SUN_RADIUS", "glint_radiance", "sun_masking_factor", "glint_from_moments", "glint_sharp_factor"]
 
 SUN_RADIUS = math.radians(0.2666)  # angular radius of the sun's disk at 1 AU [rad]
 _SQRT_HALF = math.sqrt(0.5)
@@ -78,11 +80,6 @@ class Sun:
         return 4.0 * math.pi * (torch.sin(r / 2) ** 2 if isinstance(r, torch.Tensor) else math.sin(r / 2) ** 2)
 
 
-def _nodes(n: int, dtype: torch.dtype, device: torch.device) -> tuple[torch.Tensor, torch.Tensor]:
-    x, w = np.polynomial.legendre.leggauss(n)
-    return torch.as_tensor(x, dtype=dtype, device=device), torch.as_tensor(w, dtype=dtype, device=device)
-
-
 def _ellipse_probability(cx: torch.Tensor, cy: torch.Tensor, k11: torch.Tensor, k12: torch.Tensor,
                          k22: torch.Tensor, det_k: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """P(z ∈ E') and its first moment ∫_E' z φ₂: the closed form of a small ellipse where E' is much
@@ -108,10 +105,8 @@ def _small_ellipse(cx: torch.Tensor, cy: torch.Tensor, k11: torch.Tensor, k12: t
     here to n = 2. With g = cᵀSc − tr S and T = g² + 2 tr S² − 4 cᵀS²c:
     P = area φ₂(c) F, F = 1 + g/8 + T/192, and
     ∫ z φ₂ = area φ₂(c) [c F − S c (1/4 + g/48) + S² c/24].
-    Against a 1024-ray integration over 2e5 random ellipses (axis ratios to 30, |c| < 6.5), for
-    tr S < 0.1: 1.4e-6 of the peak area φ₂(0) (P) and 4e-6 (moment), 6e-5 relative where |c| < 4;
-    the 48-ray rule is 1e-3 off on the same (thin) ellipses. (To n = 1, the earlier rule, it was
-    1.4e-4 of the peak there.)"""
+    Used where tr S < ``_SMALL_ELLIPSE`` (0.1); its accuracy there, measured against a fine ray
+    integration: ``docs/notes/sun_glint.md``."""
     s11, s12, s22 = k22 / det_k, -k12 / det_k, k11 / det_k
     area = math.pi * torch.rsqrt(det_k)
     phi = torch.exp(-0.5 * (cx * cx + cy * cy)) / (2.0 * math.pi)
@@ -159,7 +154,7 @@ def _ellipse_probability_rays(cx: torch.Tensor, cy: torch.Tensor, k11: torch.Ten
                         torch.full_like(lam1, 0.5 * math.pi))
     th_c = torch.where(inside, torch.zeros_like(phi1), phi1)
     psi1, psi2 = -gamma, gamma
-    x, w = _nodes(_N_RAYS, dtype, device)
+    x, w = gauss_nodes("gl", _N_RAYS, dtype, device)
     mid, half = 0.5 * (psi1 + psi2), 0.5 * (psi2 - psi1)
     u = torch.sin(0.5 * math.pi * x)
     du = 0.5 * math.pi * torch.cos(0.5 * math.pi * x)
@@ -203,16 +198,13 @@ def glint_radiance(view_zenith: Any, view_azimuth: Any, slopes: Any, refractive_
     Returns:
         R_glint, the broadcast shape, the inputs' dtype and device; 0 for a sun below the horizon.
     """
-    from .expectation import _prepare
-    from .optics import split_refractive_index
-
-    dtype, device, vz, va, vx, vy, cxy, mx, my = _prepare(view_zenith, view_azimuth, slopes, refractive_index,
-                                                          sun_zenith=sun.zenith, sun_azimuth=sun.azimuth,
-                                                          sun_irradiance=sun.irradiance)
+    dtype, device, vz, va, vx, vy, cxy, mx, my = prepare_inputs(view_zenith, view_azimuth, slopes, refractive_index,
+                                                                sun_zenith=sun.zenith, sun_azimuth=sun.azimuth,
+                                                                sun_irradiance=sun.irradiance)
     n, k = split_refractive_index(refractive_index, dtype, device)
     tz, tp = as_tensor(sun.zenith, dtype, device), as_tensor(sun.azimuth, dtype, device)
     e_sun, alpha = as_tensor(sun.irradiance, dtype, device), as_tensor(sun.radius, dtype, device)
-    out = _glint(vz, va, vx, vy, cxy, mx, my, n, k, tz, tp, e_sun, alpha, shadowing)
+    out = glint_from_moments(vz, va, vx, vy, cxy, mx, my, n, k, tz, tp, e_sun, alpha, shadowing)
     if sun_masking:
         out = out * sun_masking_factor(slopes, sun, dtype, device)
     return out
@@ -256,16 +248,27 @@ def _specular_ellipse(ct: torch.Tensor, st: torch.Tensor, cph: torch.Tensor, sph
     return cxw, cyw, k11, k12, k22, det_k, l11, l21, l22, above
 
 
-def _glint_sharp(ct: torch.Tensor, st: torch.Tensor, cva: torch.Tensor, sva: torch.Tensor, vx: torch.Tensor,
-                 vy: torch.Tensor, cxy: torch.Tensor, mx: torch.Tensor, my: torch.Tensor, n: torch.Tensor, k: torch.Tensor,
-                 tz: torch.Tensor, tp: torch.Tensor, alpha: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-    """P ρ t of the glint (module docstring) for lines of sight of cos/sin θ̂ and cos/sin φ̂: the
-    Gaussian probability P of the sun's ellipse in slope space, and the Fresnel ρ and facet cosine t
-    at the mean slope s* of the facets that mirror the sun; the part of the glint that is sharp in the
-    view direction (the rest, L_sun / D, is smooth). Returns (P ρ t, whether the sun is above the
-    horizon)."""
-    from .optics import _fresnel_terms
+def glint_sharp_factor(ct: torch.Tensor, st: torch.Tensor, cva: torch.Tensor, sva: torch.Tensor, vx: torch.Tensor,
+                       vy: torch.Tensor, cxy: torch.Tensor, mx: torch.Tensor, my: torch.Tensor, n: torch.Tensor,
+                       k: torch.Tensor, tz: torch.Tensor, tp: torch.Tensor, alpha: torch.Tensor
+                       ) -> tuple[torch.Tensor, torch.Tensor]:
+    """P ρ t of the glint (module docstring): the part of the glint that is sharp in the view direction
+    (the rest, L_sun / D, is smooth).
 
+    P is the Gaussian probability of the sun's ellipse in slope space; ρ and t = cos Ω / cos θ are the
+    Fresnel reflectance and the facet weight at the mean slope s* of the facets that mirror the sun.
+
+    Args:
+        ct, st, cva, sva: cos θ̂, sin θ̂, cos φ̂, sin φ̂ of the line of sight.
+        vx, vy, cxy: the slope covariance (upwind/crosswind frame); mx, my: the mean slope (tensors,
+            zero for a zero-mean law).
+        n, k: the refractive index m = n + i k.
+        tz, tp, alpha: the sun's zenith, azimuth and angular radius [rad].
+    All checked tensors of one dtype and device that broadcast together.
+
+    Returns:
+        (P ρ t, whether the sun is above the horizon), the broadcast shape.
+    """
     cxw, cyw, k11, k12, k22, det_k, l11, l21, l22, above = _specular_ellipse(ct, st, cva, sva, vx, vy, cxy, mx, my,
                                                                              tz, tp, alpha)
     shape = torch.broadcast_shapes(cxw.shape, cyw.shape, k11.shape, k12.shape, k22.shape, det_k.shape)
@@ -282,29 +285,39 @@ def _glint_sharp(ct: torch.Tensor, st: torch.Tensor, cva: torch.Tensor, sva: tor
     s_y = my + l21 * zx + l22 * zy
     t_g = ct + st * (s_x * cva + s_y * sva)
     cos_omega = (t_g * torch.rsqrt(1.0 + s_x * s_x + s_y * s_y)).clamp(0.0, 1.0)
-    rs_, rp_ = _fresnel_terms(cos_omega, n, k)
+    rs_, rp_ = fresnel_terms(cos_omega, n, k)
     return 0.5 * (rs_ + rp_) * t_g * prob, above
 
 
-def _glint(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor,
-           mx: torch.Tensor | None, my: torch.Tensor | None, n: torch.Tensor, k: torch.Tensor, tz: torch.Tensor,
-           tp: torch.Tensor, e_sun: torch.Tensor, alpha: torch.Tensor, shadowing: bool, smooth: bool = False) -> Any:
-    """:func:`glint_radiance` without the sun's masking, on checked tensors (the renderer calls it on
-    its own pixels, whose values need no second check): P ρ t L_sun / D (:func:`_glint_sharp`).
-    With ``smooth``, only the smooth factor L_sun / D (0 for a sun below the horizon), which the
-    renderer tabulates."""
-    from .expectation import _denominator, _geometry
+def glint_from_moments(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy: torch.Tensor, cxy: torch.Tensor,
+                       mx: torch.Tensor | None, my: torch.Tensor | None, n: torch.Tensor, k: torch.Tensor,
+                       tz: torch.Tensor, tp: torch.Tensor, e_sun: torch.Tensor, alpha: torch.Tensor, shadowing: bool,
+                       smooth: bool = False) -> Any:
+    """:func:`glint_radiance` without the sun's masking, from the slope moments as checked tensors (the
+    renderer calls it on its own pixels, whose values need no second check): P ρ t L_sun / D
+    (:func:`glint_sharp_factor`) [W m⁻² sr⁻¹ in the irradiance's band].
 
+    Args:
+        vz, va: θ̂, φ̂ of the line of sight [rad].
+        vx, vy, cxy: the slope covariance; mx, my: the mean slope, or None for zero mean.
+        n, k: the refractive index m = n + i k.
+        tz, tp: the sun's zenith and azimuth [rad]; e_sun: its irradiance [W m⁻²]; alpha: its angular
+            radius [rad].
+        shadowing: Eq. 5 (True) or Eq. 7 for D.
+        smooth: only the smooth factor L_sun / D (0 for a sun below the horizon), which the renderer
+            tabulates.
+    All tensors of one dtype and device that broadcast together; the result has the broadcast shape.
+    """
     dtype, device = vz.dtype, vz.device
     zero = torch.zeros((), dtype=dtype, device=device)
     if mx is None:
         mx = my = zero
-    D = _denominator(_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
+    D = denominator(facet_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
     l_sun = e_sun / (4.0 * math.pi * torch.sin(0.5 * alpha) ** 2)  # Ω_sun = 2π(1 − cos α), without cancellation
     if smooth:
         return torch.where(torch.cos(tz) > 0, l_sun / D, zero)
-    sharp, above = _glint_sharp(torch.cos(vz), torch.sin(vz), torch.cos(va), torch.sin(va), vx, vy, cxy, mx, my, n,
-                                   k, tz, tp, alpha)
+    sharp, above = glint_sharp_factor(torch.cos(vz), torch.sin(vz), torch.cos(va), torch.sin(va), vx, vy, cxy, mx, my,
+                                      n, k, tz, tp, alpha)
     return torch.where(above, sharp * l_sun / D, zero)
 
 
@@ -315,12 +328,11 @@ def sun_masking_factor(slopes: Any, sun: Sun, dtype: torch.dtype = torch.float64
 
     A textured sea applies the G1 of the scene's total slope law to every pixel's glint (the resolved
     waves mask the sun too), so that its ensemble mean is the expectation's glint."""
-    from .expectation import _denominator, _geometry
-
     tz, tp = as_tensor(sun.zenith, dtype, device), as_tensor(sun.azimuth, dtype, device)
     vx, vy, cxy = slopes.tensors(dtype, device)
     mx, my = slopes.mean_tensors(dtype, device)
-    gs = _geometry(tz.clamp_max(math.pi / 2), tp, vx, vy, cxy, mx, my)
-    d_sun = _denominator(gs, True)
+    gs = facet_geometry(tz.clamp_max(math.pi / 2), tp, vx, vy, cxy, mx, my)
+    d_sun = denominator(gs, True)
     e_s = (gs.ct + gs.st * gs.mu).clamp_min(0.0)
     return (e_s / d_sun.clamp_min(torch.finfo(dtype).tiny)).clamp(0.0, 1.0)
+

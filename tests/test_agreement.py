@@ -110,7 +110,7 @@ def test_batched_call_equals_per_case_reference(reference_values):
     torch.testing.assert_close(r, expected, rtol=1e-6, atol=0.0)
 
 
-# Shifted slope Gaussians (the unresolved part of the two-scale sea, waves.md §2): (view zenith
+# Shifted slope Gaussians (the unresolved part of the two-scale sea, docs/texture.md §5): (view zenith
 # [deg], view azimuth [rad], (a, b, r), mean (upwind, crosswind), shadowing)
 SHIFTED = [
     (60.0, 0.7, (0.12, 0.09, 0.2), (0.08, -0.03), True),

@@ -18,7 +18,9 @@ import torch
 
 from roughsea_torch import atmosphere as atm
 from roughsea_torch.radiometry import LWIR, MWIR, as_band, band_radiance, brightness_temperature
-from roughsea_torch.sky import TabulatedSky, as_sky
+from roughsea_torch.atmosphere import as_sky
+from roughsea_torch.lowtran import atmosphere_tables
+from roughsea_torch.sky import TabulatedSky
 
 NAMES = list(atm.ATMOSPHERES)
 BANDS = {"lwir": LWIR, "mwir": MWIR}
@@ -26,7 +28,7 @@ MLS = "midlatitude_summer"
 
 
 def _tables(name: str) -> dict:
-    return atm._tables(name)
+    return atmosphere_tables(name)
 
 
 def _cosd(deg) -> torch.Tensor:

@@ -38,7 +38,7 @@ def _mixture(th_deg, transport, n=80, dtype=torch.float64):
 
 @pytest.mark.parametrize("th_deg", [40.0, 75.0, 85.0, 88.0, 89.5])
 def test_visible_slope_makes_the_mixture_the_expectation(th_deg):
-    """∫ N(x) R(a'(x)) dx = R_a(Σ): the Eq. 5 weighting of the resolved slope (waves.md §3)."""
+    """∫ N(x) R(a'(x)) dx = R_a(Σ): the Eq. 5 weighting of the resolved slope (docs/texture.md §6)."""
     assert abs(_mixture(th_deg, True)) < 2e-6
 
 

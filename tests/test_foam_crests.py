@@ -1,7 +1,7 @@
 """Foam on the crests of a textured sea: roughsea_torch.foam.crest_foam_fraction fed with the crest
 variable of roughsea_torch.waves.WaveField (and the TextureTable hook that samples it per pixel).
 
-What must hold (issue 12, item 3; docs/waves.md §3, §6): the ensemble mean of the pixel's foam
+What must hold (issue 12, item 3; docs/texture.md §8, §13): the ensemble mean of the pixel's foam
 fraction is Monahan's W exactly, whatever the footprint; the far field is the uniform-fraction
 image; the foam sits on crests; it is independent of the resolved slopes (so it does not bias the
 slope texture); W = 0 means no foam; gradients are finite at the degenerate ends and right inside;

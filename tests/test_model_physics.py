@@ -1,6 +1,6 @@
 """Physics of the model, asserted identically of every backend (reference, torch64, torch32).
 
-Facts come from the paper and ``docs/physics.md`` §6; none is a value produced by this code.
+Facts come from the paper and ``docs/physics.md`` §13; none is a value produced by this code.
 """
 
 from __future__ import annotations
@@ -69,7 +69,7 @@ def test_no_shadowing_denominator_is_cos_view_zenith(backend):
 
 
 def test_shadowing_adds_projected_area_smith_lambda(backend):
-    """physics.md §6: Smith's Λ at 85°, isotropic Cox–Munk, W = 5 → 0.185, W = 10 → 0.354."""
+    """docs/physics.md §13: Smith's Λ at 85°, isotropic Cox–Munk, W = 5 → 0.185, W = 10 → 0.354."""
     th = 85 * DEG
     for w, expected in ((5.0, 0.185), (10.0, 0.354)):
         d = backend.projected_area(th, 0.0, backend.cox_munk(w))
@@ -95,14 +95,14 @@ def test_flat_sea_limit_is_fresnel(backend, theta_deg):
     [(1.351 + 0.0046j, 0.97771), (M10, 0.98982), (M11, 0.99294), (1.111 + 0.199j, 0.98845)],
 )
 def test_normal_incidence_emissivity_hale_querry(backend, m, e0):
-    """physics.md §6: 1 − ρ₀ with ρ₀ = ((n−1)² + k²)/((n+1)² + k²) for Hale & Querry water."""
+    """docs/physics.md §13: 1 − ρ₀ with ρ₀ = ((n−1)² + k²)/((n+1)² + k²) for Hale & Querry water."""
     rho = backend.fresnel_reflectance(1.0, m)
     assert abs((1 - rho) - e0) < 6e-6
 
 
 @pytest.mark.parametrize("m, e85, e89", [(M10, 0.4544, 0.1152), (M11, 0.4682, 0.1194)])
 def test_flat_sea_grazing_emissivity_hale_querry(backend, m, e85, e89):
-    """physics.md §6: flat-sea emissivity at 85° and 89°."""
+    """docs/physics.md §13: flat-sea emissivity at 85° and 89°."""
     for theta, expected in ((85.0, e85), (89.0, e89)):
         rho = backend.fresnel_reflectance(math.cos(theta * DEG), m)
         assert abs((1 - rho) - expected) < 6e-5
@@ -121,7 +121,7 @@ def test_s_and_p_parts_average_to_unpolarized_and_brewster(backend):
 
 
 def test_unnormalized_emissivity_exceeds_one_near_grazing(backend):
-    """physics.md §6: dividing by cos θ̂ instead of the shadowed denominator gives ≈ 1.19 at 85°,
+    """docs/physics.md §13: dividing by cos θ̂ instead of the shadowed denominator gives ≈ 1.19 at 85°,
     11 µm, W = 15 — so the library's normalized emissivity must stay below 1."""
     th, slopes = 85 * DEG, backend.cox_munk(15.0)
     eps = backend.emissivity(th, 0.0, slopes, M11)

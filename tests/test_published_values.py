@@ -85,7 +85,7 @@ def test_fresnel_emissivity_is_one_minus_fresnel_reflectance(dtype):
         got = rs.fresnel_emissivity(ct, m).double().numpy()
         expected = np.array([1.0 - 0.5 * sum(exact_fresnel(float(ci), m)) for ci in ct.double().numpy()])
         np.testing.assert_allclose(got, expected, rtol=2e-6 if dtype == torch.float32 else 1e-12, atol=1e-7 if dtype == torch.float32 else 0)
-    assert float(rs.fresnel_emissivity(1.0, M10)) == pytest.approx(0.98982, abs=6e-6)  # physics.md §6
+    assert float(rs.fresnel_emissivity(1.0, M10)) == pytest.approx(0.98982, abs=6e-6)  # docs/physics.md §13
 
 
 def smith_lambda_closed_form(theta: float, sigma_par: float) -> float:
@@ -97,8 +97,8 @@ def smith_lambda_closed_form(theta: float, sigma_par: float) -> float:
 @pytest.mark.parametrize("dtype", [torch.float64, torch.float32])
 def test_smith_lambda_closed_form(dtype):
     """``smith_lambda`` against Smith's closed form with σ∥² = a² cos²φ̂ + 2 r a b cos φ̂ sin φ̂ +
-    b² sin²φ̂ (physics.md §3), for an anisotropic correlated law at several azimuths; and the
-    published values of physics.md §6 (85°, isotropic Cox–Munk: W = 5 → 0.185, W = 10 → 0.354)."""
+    b² sin²φ̂ (docs/physics.md §3), for an anisotropic correlated law at several azimuths; and the
+    published values of docs/physics.md §13 (85°, isotropic Cox–Munk: W = 5 → 0.185, W = 10 → 0.354)."""
     a, b, r = 0.22, 0.09, 0.5
     s = rs.SlopeStatistics(torch.tensor(a, dtype=dtype), b, r)
     for th_deg in (50.0, 70.0, 80.0, 85.0, 88.0):
@@ -153,7 +153,7 @@ def test_segelstein_table_published_values_and_consistency_with_hale_querry():
     """Segelstein 1981 (refractiveindex.info page main/H2O/Segelstein), the row at 10.000 µm:
     n = 1.193164, k = 0.050791394. Both it and Hale & Querry 1973 measure liquid water: over
     8–12 µm they agree to |Δn| < 0.03 and |Δk| < 20 % of k, and both give a normal-incidence
-    emissivity ≈ 0.99 at 10 µm (0.98982 for Hale & Querry, physics.md §6)."""
+    emissivity ≈ 0.99 at 10 µm (0.98982 for Hale & Querry, docs/physics.md §13)."""
     m = complex(rs.water_refractive_index(torch.tensor(10e-6, dtype=torch.float64), "segelstein"))
     assert abs(m.real - 1.193164) < 1e-9 and abs(m.imag - 0.050791394) < 1e-12
     lam = torch.linspace(8e-6, 12e-6, 81, dtype=torch.float64)
@@ -169,7 +169,7 @@ def test_segelstein_table_published_values_and_consistency_with_hale_querry():
 
 @pytest.mark.parametrize("w", [0.0, 3.0, 10.0, 25.0])
 def test_cox_munk_1954_slope_variances(backend, w):
-    """Cox & Munk 1954, clean surface (physics.md §4): isotropic σ² = 0.003 + 5.12e-3 W split
+    """Cox & Munk 1954, clean surface (docs/physics.md §5): isotropic σ² = 0.003 + 5.12e-3 W split
     equally (the paper's Eq. 12); anisotropic upwind a² = 3.16e-3 W, crosswind b² = 0.003 +
     1.92e-3 W, uncorrelated. At 10 m/s σ² = 0.0542 (Cox & Munk's rms slope 0.23)."""
 
@@ -190,7 +190,7 @@ def test_cox_munk_1954_slope_variances(backend, w):
 
 
 def test_slope_statistics_accessors_are_the_covariance_entries():
-    """Σ = [[a², r a b], [r a b, b²]] (physics.md §2): a, b, r given are returned, σ² = a² + b²."""
+    """Σ = [[a², r a b], [r a b, b²]] (docs/physics.md §2): a, b, r given are returned, σ² = a² + b²."""
     s = rs.SlopeStatistics(torch.tensor(0.3, dtype=torch.float64), 0.1, -0.4)
     assert abs(float(s.std_upwind) - 0.3) < 1e-15 and abs(float(s.std_crosswind) - 0.1) < 1e-15
     assert abs(float(s.corr) + 0.4) < 1e-15 and abs(float(s.cov) + 0.4 * 0.03) < 1e-15
@@ -212,7 +212,7 @@ def test_invalid_slope_covariance_and_zero_response_raise():
 
 
 def test_band_index_in_mwir_is_the_planck_weighted_average():
-    """physics.md §5 / ``band_refractive_index``: over 3–5 µm the least-squares fit wants k < 0, so
+    """docs/physics.md §6 / ``band_refractive_index``: over 3–5 µm the least-squares fit wants k < 0, so
     the Planck-weighted average (n̄, k̄) is returned; it reproduces the band-averaged reflectance to
     3e-4 at every angle. Over 8–12 µm the fit is returned, and beats the average 20-fold."""
     mw = complex(rs.band_refractive_index((3e-6, 5e-6), 290.0))

@@ -2,8 +2,8 @@
 
 Every fact is checked against something that does not go through the reference's own quadrature:
 a closed form, plain-vector mirror geometry, the zero-mean code path, a Gauss-Hermite mixture over
-mu (the two-scale principle of docs/waves.md sec. 2), or an exact symmetry of the model.
-Convention (physics.md sec. 2): s = tan(theta) (cos phi, sin phi) is the direction the facet normal
+mu (the two-scale principle of docs/texture.md sec. 5), or an exact symmetry of the model.
+Convention (docs/physics.md sec. 2): s = tan(theta) (cos phi, sin phi) is the direction the facet normal
 leans towards, n = (s_x, s_y, 1)/sqrt(1 + |s|^2); phi_hat is the azimuth of the line of sight
 sea -> sensor from the upwind axis. Runs in about half a minute.
 """
@@ -18,7 +18,7 @@ from scipy import stats
 import roughsea_torch.reference as ref
 
 DEG = math.pi / 180.0
-M10 = complex(1.218, 0.0508)  # water at 10 um, Hale & Querry (physics.md sec. 5)
+M10 = complex(1.218, 0.0508)  # water at 10 um, Hale & Querry (docs/physics.md sec. 6)
 RB = 30.0                     # sea radiance, equal to the sky at the horizon
 
 
@@ -30,7 +30,7 @@ def sky(c):
 # ------------------------------------------------------------------- independent pieces
 
 def closed_form_area(th, ph, a, b, r, mu, shadowing):
-    """D = E[t H(t)], t = cos th + sin th u, u = s . (cos ph, sin ph) ~ N(m, sigma^2) (physics.md sec. 3)."""
+    """D = E[t H(t)], t = cos th + sin th u, u = s . (cos ph, sin ph) ~ N(m, sigma^2) (docs/physics.md sec. 3)."""
     c, s = math.cos(ph), math.sin(ph)
     m = mu[0] * c + mu[1] * s
     sigma = math.sqrt(a * a * c * c + 2.0 * r * a * b * c * s + b * b * s * s)

@@ -1,7 +1,7 @@
 """The numpy reference for the reflected sun (roughsea_torch.reference.sun.glint_radiance).
 
 Each fact is checked against something outside the disk quadrature: the polygon area of a disk's
-image in slope space (the change of variables), Cox & Munk's closed form (waves.md sec. 5), the
+image in slope space (the change of variables), Cox & Munk's closed form (docs/physics.md sec. 10), the
 flat-sea mirror, energy conservation over all view directions computed in slope space, and Smith's
 G1 recomputed from the reference's projected_area quadrature.
 """
@@ -16,7 +16,7 @@ import roughsea_torch.reference as ref
 from roughsea_torch.reference.sun import _slope_of_direction, _unit
 
 DEG = math.pi / 180.0
-M4 = complex(1.351, 0.0046)  # water at 4 um, Hale & Querry (physics.md sec. 5)
+M4 = complex(1.351, 0.0046)  # water at 4 um, Hale & Querry (docs/physics.md sec. 6)
 R_SUN = 0.004654
 E_SUN = 12.0
 
@@ -130,7 +130,7 @@ def test_energy_over_all_view_directions():
     facet the mirror v -> r preserves solid angle and n.v = n.r, so swapping the integrals gives
     E_sun int N(s) (n.c)/n_z rho(n.c) ds over the facets that reflect the sun into the upper
     hemisphere (up to the disk's finite size, O(R^2)): in slope space the circle
-    (s_par - tan th_s)^2 + s_perp^2 < sec^2 th_s (physics.md sec. 3, with the sun for the view),
+    (s_par - tan th_s)^2 + s_perp^2 < sec^2 th_s (docs/physics.md sec. 3, with the sun for the view),
     inside which n.c > 0. (n.c)/n_z = cos th_s + sin th_s s_par (the Eq. 4 facet weight toward
     the sun), so this is E_sun cos th_s times the weighted reflectance of the lit facets.
     """

@@ -67,7 +67,7 @@ def test_table_render_matches_direct_per_pixel_evaluation(dtype, anisotropic, sk
 
 
 def test_horizon_depression_and_distance_on_a_sphere():
-    """physics.md §8: at h = 20 m the horizon is depressed by √(2h/R) = 0.1436° and lies √(2hR) ≈ 16 km
+    """docs/physics.md §9: at h = 20 m the horizon is depressed by √(2h/R) = 0.1436° and lies √(2hR) ≈ 16 km
     away. A camera pitched to the horizon: the first sea row is the one just below it, and the
     sea pixel farthest away is at ≈ the horizon distance."""
     h, R = 20.0, 6_371_000.0
@@ -80,7 +80,7 @@ def test_horizon_depression_and_distance_on_a_sphere():
     f = float(cams.fx[0])
     elev = lambda row: -dip + math.degrees(math.atan(((H - 1) / 2 - row) / f))  # noqa: E731
     row_deg = math.degrees(math.atan(1 / f))  # one row [deg]
-    # the sea starts at the depressed horizon, 0.1436° below the horizontal (physics.md §8)
+    # the sea starts at the depressed horizon, 0.1436° below the horizontal (docs/physics.md §9)
     assert elev(first) <= -0.1436 + row_deg and elev(first - 1) > -0.1436 - row_deg
     far = float(geom.range_m[0, first, 1])
     assert abs(far - math.sqrt(2 * h * R)) / math.sqrt(2 * h * R) < 0.02

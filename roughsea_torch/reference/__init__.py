@@ -17,7 +17,7 @@ Choices and notes on the paper (see also the docstrings):
 * The paper's symmetry "p(theta, phi) = p(theta, pi - phi)" is a mirror symmetry that fails when
   r != 0; what makes the Eq. 5 denominator equal cos(th) without shadowing is the inversion
   p(theta, phi) = p(theta, phi + pi), which holds for every Gaussian law (checked by quadrature).
-* Reflected rays with cos(theta') < 0 see R_B (physics.md sec. 2). Without shadowing (Eq. 7) the
+* Reflected rays with cos(theta') < 0 see R_B (docs/physics.md sec. 4). Without shadowing (Eq. 7) the
   hidden facets keep negative weight, and near grazing the apparent radiance becomes strongly
   unphysical (e.g. about -1.76e3 at 89.99 deg, W = 10, for R_B = 30): that is what Eq. 7 gives.
 * Without shadowing at th = pi/2 exactly, Eq. 7 is 0/0: emissivity and apparent_radiance return NaN.

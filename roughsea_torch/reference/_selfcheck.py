@@ -15,8 +15,8 @@ from scipy import integrate, special, stats
 from roughsea_torch.reference import (SlopeStatistics, apparent_radiance, band_radiance,
                                       brightness_temperature, emissivity, fresnel_reflectance,
                                       planck_radiance, projected_area, slope_pdf)
-from roughsea_torch.reference.fresnel import _fresnel_scalar
-from roughsea_torch.reference.rough_sea import _numerator
+from roughsea_torch.reference.fresnel import fresnel_scalar
+from roughsea_torch.reference.rough_sea import numerator
 
 DEG = math.pi / 180.0
 HQ = {"4um": complex(1.351, 0.0046), "10um": complex(1.218, 0.0508),
@@ -36,7 +36,7 @@ def header(title):
 
 
 def closed_form_D(th, ph, a, b, r):
-    """physics.md sec. 3: D = cos th Phi(mu) + sin th s_par phi_N(mu), mu = cot th / s_par."""
+    """docs/physics.md sec. 3: D = cos th Phi(mu) + sin th s_par phi_N(mu), mu = cot th / s_par."""
     s_par = math.sqrt(a * a * math.cos(ph) ** 2 + 2 * r * a * b * math.cos(ph) * math.sin(ph)
                       + b * b * math.sin(ph) ** 2)
     ct, st = math.cos(th), math.sin(th)
@@ -114,7 +114,7 @@ def check_area_noshadow():
 
 
 def check_area_shadow():
-    header("3. projected_area(shadowing=True): quadrature (phi-outer and theta-outer) vs the closed form of physics.md sec. 3")
+    header("3. projected_area(shadowing=True): quadrature (phi-outer and theta-outer) vs the closed form of docs/physics.md sec. 3")
     laws = [("iso W=10", SlopeStatistics.cox_munk(10.0)),
             ("aniso W=10", SlopeStatistics.cox_munk(10.0, anisotropic=True)),
             ("a/b=10 r=0.9", SlopeStatistics(0.2, 0.02, 0.9)),
@@ -161,29 +161,29 @@ def check_second_law():
 
 
 def check_facts():
-    header("5. Flat-sea limit and the facts of physics.md sec. 6")
+    header("5. Flat-sea limit and the facts of docs/physics.md sec. 13")
     expect_n = {"4um": 0.97771, "10um": 0.98982, "11um": 0.99294, "12um": 0.98845}
     for key, m in HQ.items():
         e = 1 - float(fresnel_reflectance(1.0, m))
         e0 = 1 - ((m.real - 1) ** 2 + m.imag ** 2) / ((m.real + 1) ** 2 + m.imag ** 2)
-        print(f"  normal incidence {key:4s} m={m}: 1-rho = {e:.5f} (closed {e0:.5f}, physics.md {expect_n[key]:.5f})")
+        print(f"  normal incidence {key:4s} m={m}: 1-rho = {e:.5f} (closed {e0:.5f}, docs/physics.md {expect_n[key]:.5f})")
     flat = SlopeStatistics(0.0, 0.0)
     expect = {("10um", 85): 0.4544, ("10um", 89): 0.1152, ("11um", 85): 0.4682, ("11um", 89): 0.1194}
     for (key, thd), ex in expect.items():
         e = float(emissivity(thd * DEG, 0.0, flat, HQ[key]))
-        print(f"  flat sea {key:4s} {thd} deg: emissivity = {e:.4f} ({e:.7f}); physics.md {ex}")
+        print(f"  flat sea {key:4s} {thd} deg: emissivity = {e:.4f} ({e:.7f}); docs/physics.md {ex}")
     # emissivity of a very calm sea tends to the flat value
     calm = SlopeStatistics(1e-6, 1e-6)
     e = float(emissivity(85 * DEG, 0.0, calm, HQ["11um"]))
-    print(f"  rms slope 1e-6 (quadrature), 11um, 85 deg: {e:.10f} vs flat {1 - _fresnel_scalar(math.cos(85 * DEG), HQ['11um']):.10f}")
+    print(f"  rms slope 1e-6 (quadrature), 11um, 85 deg: {e:.10f} vs flat {1 - fresnel_scalar(math.cos(85 * DEG), HQ['11um']):.10f}")
     # unnormalized emissivity (Eq. 5 numerator divided by cos th instead of D)
     S15 = SlopeStatistics.cox_munk(15.0)
     a = float(S15.std_upwind)
     th = 85 * DEG
-    num = _numerator("emis", th, 0.0, a, a, 0.0, True, m=HQ["11um"])
+    num = numerator("emis", th, 0.0, a, a, 0.0, True, m=HQ["11um"])
     d = float(projected_area(th, 0.0, S15))
     e_norm = float(emissivity(th, 0.0, S15, HQ["11um"]))
-    print(f"  W=15 iso, 11um, 85 deg: unnormalized (num/cos th) = {num / math.cos(th):.4f}  (physics.md ~1.19);"
+    print(f"  W=15 iso, 11um, 85 deg: unnormalized (num/cos th) = {num / math.cos(th):.4f}  (docs/physics.md ~1.19);"
           f" normalized (Eq. 5) = {e_norm:.4f}; no shadowing (Eq. 7) = "
           f"{float(emissivity(th, 0.0, S15, HQ['11um'], shadowing=False)):.4f}; D/cos = {d / math.cos(th):.4f}")
     for w, ex in [(5.0, 0.185), (10.0, 0.354)]:
@@ -192,7 +192,7 @@ def check_facts():
         sigma = math.sqrt(0.003 + 5.12e-3 * w)
         nu = 1 / math.tan(th) / sigma
         smith = 0.5 * (math.exp(-nu * nu) / (nu * math.sqrt(math.pi)) - special.erfc(nu))
-        print(f"  Smith Lambda, 85 deg, W={w:g}: D/cos - 1 = {lam:.6f}; Smith formula {smith:.6f}; physics.md {ex}")
+        print(f"  Smith Lambda, 85 deg, W={w:g}: D/cos - 1 = {lam:.6f}; Smith formula {smith:.6f}; docs/physics.md {ex}")
 
 
 def check_misc():
@@ -212,7 +212,7 @@ def check_misc():
         print(f"  Fresnel n=1.33 {deg:4.1f} deg: s {mine_s:.15f} vs Snell {rs:.15f}; p {mine_p:.15f} vs {rp:.15f}")
     c = np.linspace(-1, 1, 41)
     v = fresnel_reflectance(c, np.array([HQ['10um']]))
-    sc = np.array([_fresnel_scalar(abs(x), HQ['10um']) for x in c])
+    sc = np.array([fresnel_scalar(abs(x), HQ['10um']) for x in c])
     print(f"  vectorized vs scalar Fresnel, max diff {np.max(np.abs(v - sc)):.1e}; even in cos: "
           f"{np.max(np.abs(v - v[::-1])):.1e}; rho(cos=0) = {float(fresnel_reflectance(0.0, HQ['10um'])):.15f}")
     # Planck

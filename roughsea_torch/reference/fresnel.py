@@ -13,7 +13,7 @@ import cmath
 
 import numpy as np
 
-__all__ = ["fresnel_reflectance", "as_complex_index"]
+__all__ = ["fresnel_reflectance", "as_complex_index", "fresnel_scalar"]
 
 
 def as_complex_index(refractive_index):
@@ -36,8 +36,9 @@ def as_complex_index(refractive_index):
     return m
 
 
-def _fresnel_scalar(c, m, polarization="unpolarized"):
-    """Fresnel reflectance for one cos(incidence) c in [0, 1] and complex m (plain Python)."""
+def fresnel_scalar(c, m, polarization="unpolarized"):
+    """Fresnel reflectance for one cos(incidence) c in [0, 1] and complex m (plain Python; the formulas
+    above). Shared within the reference: the integrands of ``rough_sea`` and ``sun`` call it per point."""
     sin2 = 1.0 - c * c
     m2 = m * m
     w = cmath.sqrt(m2 - sin2)

@@ -9,11 +9,12 @@ import math
 
 import numpy as np
 
-__all__ = ["SlopeStatistics", "slope_pdf"]
+__all__ = ["SlopeStatistics", "slope_pdf", "check_slope_arrays", "pdf_scalar"]
 
 
-def _check_slope_arrays(std_upwind, std_crosswind, corr):
-    """Validate rms slopes (>= 0, not NaN) and correlation (|r| < 1); raise ValueError naming the argument."""
+def check_slope_arrays(std_upwind, std_crosswind, corr):
+    """Validate rms slopes (>= 0, not NaN) and correlation (|r| < 1); raise ValueError naming the argument.
+    Returns the three as float64 arrays. Shared within the reference (``rough_sea``)."""
     a = np.asarray(std_upwind, dtype=np.float64)
     b = np.asarray(std_crosswind, dtype=np.float64)
     r = np.asarray(corr, dtype=np.float64)
@@ -40,7 +41,7 @@ class SlopeStatistics:
     """
 
     def __init__(self, std_upwind, std_crosswind, corr=0.0):
-        a, b, r = _check_slope_arrays(std_upwind, std_crosswind, corr)
+        a, b, r = check_slope_arrays(std_upwind, std_crosswind, corr)
         a, b, r = np.broadcast_arrays(a, b, r)
         self.std_upwind = np.array(a, dtype=np.float64)
         self.std_crosswind = np.array(b, dtype=np.float64)
@@ -71,8 +72,9 @@ class SlopeStatistics:
             self.std_upwind, self.std_crosswind, self.corr)
 
 
-def _pdf_scalar(theta, phi, a, b, r):
-    """p(theta, phi) of Eq. A7/A8 for one point, a > 0, b > 0, |r| < 1 (per rad^2).
+def pdf_scalar(theta, phi, a, b, r):
+    """p(theta, phi) of Eq. A7/A8 for one point, a > 0, b > 0, |r| < 1 (per rad^2). Shared within the
+    reference (the integrand of ``facet_integral``).
 
     Eq. A7: p = sec^2(theta) tan(theta) / (2 pi a b sqrt(1 - r^2))
                 * exp(-tan^2(theta) E(phi, r) / (2 (1 - r^2)))
@@ -109,14 +111,14 @@ def slope_pdf(theta, phi, slopes):
     returns 0 off the support and +inf on it (phi = 0 or pi when the crosswind slope is 0,
     phi = pi/2 or 3pi/2 when the upwind slope is 0, theta > 0); both 0: +inf at theta = 0 only.
     """
-    a, b, r = _check_slope_arrays(slopes.std_upwind, slopes.std_crosswind, slopes.corr)
+    a, b, r = check_slope_arrays(slopes.std_upwind, slopes.std_crosswind, slopes.corr)
     th, ph, a, b, r = np.broadcast_arrays(np.asarray(theta, dtype=np.float64),
                                           np.asarray(phi, dtype=np.float64), a, b, r)
     out = np.empty(th.shape, dtype=np.float64)
     for idx in np.ndindex(th.shape):
         t_, p_, a_, b_, r_ = float(th[idx]), float(ph[idx]), float(a[idx]), float(b[idx]), float(r[idx])
         if a_ > 0.0 and b_ > 0.0:
-            out[idx] = _pdf_scalar(t_, p_, a_, b_, r_)
+            out[idx] = pdf_scalar(t_, p_, a_, b_, r_)
         elif not (0.0 <= t_ < 0.5 * math.pi):
             out[idx] = 0.0
         elif a_ == 0.0 and b_ == 0.0:

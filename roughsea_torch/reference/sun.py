@@ -8,7 +8,7 @@ Omega_sun = 2 pi (1 - cos R) = 4 pi sin^2(R/2), E_sun = ``irradiance`` on a plan
 Model: Eq. 10 of the paper with R_s replaced by the sun's radiance (sky and emission left out),
 
     R_glint = (1/D) int N(s; mu, Sigma) t(s) H(t) rho(cos Omega) L_sun(r(s)) ds,
-    t(s) = cos Omega / cos beta = cos th + sin th s_par     (physics.md sec. 3),
+    t(s) = cos Omega / cos beta = cos th + sin th s_par     (docs/physics.md sec. 3),
 
 beta the facet-normal zenith, Omega the angle between the normal n = (s_x, s_y, 1)/sqrt(1 + |s|^2)
 and the line of sight v, r(s) = 2 (n.v) n - v the mirrored line of sight, L_sun(r) = L_sun inside the
@@ -73,10 +73,10 @@ import numpy as np
 from scipy import integrate
 from scipy.special import ndtr
 
-from .fresnel import _fresnel_scalar, as_complex_index
-from .rough_sea import (HALF_PI, TWO_PI, _check_slope_mean, _check_view, _denominator,
-                        _is_shifted, _mean_facet_weight, _shifted_denominator_or_nan,
-                        _slope_arrays)
+from .facet_integral import HALF_PI, TWO_PI
+from .fresnel import as_complex_index, fresnel_scalar
+from .rough_sea import (check_slope_mean, check_view, denominator, is_shifted, mean_facet_weight,
+                        shifted_denominator_or_nan, slope_arrays)
 
 __all__ = ["glint_radiance", "sun_masking_g1", "sun_solid_angle"]
 
@@ -162,8 +162,8 @@ def _lambda_g1(th_s, ph_s, a, b, r, mean):
 def sun_masking_g1(sun_zenith, sun_azimuth, slopes, *, slope_mean=(0.0, 0.0)):
     """Smith's sun-side masking factor G1 = 1/(1 + Lambda) (module docstring), broadcast, float64."""
     th, ph = np.asarray(sun_zenith, dtype=np.float64), np.asarray(sun_azimuth, dtype=np.float64)
-    a, b, r = _slope_arrays(slopes)
-    mx, my = _check_slope_mean(slope_mean)
+    a, b, r = slope_arrays(slopes)
+    mx, my = check_slope_mean(slope_mean)
     th, ph, a, b, r, mx, my = np.broadcast_arrays(th, ph, a, b, r, mx, my)
     out = np.empty(th.shape, dtype=np.float64)
     for idx in np.ndindex(th.shape):
@@ -253,7 +253,7 @@ class _DiskIntegral:
         if dens == 0.0:
             return 0.0
         cb2 = cos_beta * cos_beta
-        return dens * _fresnel_scalar(min(cos_omega, 1.0), self.m) / (4.0 * cb2 * cb2) * sr
+        return dens * fresnel_scalar(min(cos_omega, 1.0), self.m) / (4.0 * cb2 * cb2) * sr
 
     def _ladder(self, lo, hi):
         if self.w is None:
@@ -299,7 +299,7 @@ def _flat_glint(v, c, sun_radius, m, mean):
         return 0.0
     ref = _normalize(_mirror(v, n))
     if ref[2] > 0.0 and _angle(ref, c) <= sun_radius:
-        return _fresnel_scalar(min(nv, 1.0), m)
+        return fresnel_scalar(min(nv, 1.0), m)
     return 0.0
 
 
@@ -320,8 +320,8 @@ def glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun_zeni
     """
     if centre not in ("auto", "sun", "peak"):
         raise ValueError("centre must be 'auto', 'sun' or 'peak'")
-    th, ph = _check_view(view_zenith, view_azimuth)
-    a, b, r = _slope_arrays(slopes)
+    th, ph = check_view(view_zenith, view_azimuth)
+    a, b, r = slope_arrays(slopes)
     m = as_complex_index(refractive_index)
     ths = np.asarray(sun_zenith, dtype=np.float64)
     phs = np.asarray(sun_azimuth, dtype=np.float64)
@@ -336,7 +336,7 @@ def glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun_zeni
     if not 0.0 < radius < 0.1:
         raise ValueError("sun_radius must lie in (0, 0.1) rad")
     l_unit = 1.0 / sun_solid_angle(radius)
-    mx, my = _check_slope_mean(slope_mean)
+    mx, my = check_slope_mean(slope_mean)
     arrs = np.broadcast_arrays(th, ph, a, b, r, m, ths, phs, e_sun, mx, my)
     th, ph, a, b, r, m, ths, phs, e_sun, mx, my = arrs
     out = np.empty(th.shape, dtype=np.float64)
@@ -348,8 +348,8 @@ def glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun_zeni
         v, c = _unit(t_, p_), _unit(ts_, ps_)
         g1 = _lambda_g1(ts_, ps_, a_, b_, r_, mean) if sun_masking else 1.0
         if a_ == 0.0 and b_ == 0.0:
-            if _is_shifted(mean):
-                w = _mean_facet_weight(t_, p_, mean)
+            if is_shifted(mean):
+                w = mean_facet_weight(t_, p_, mean)
                 if not (w > 0.0 if shadowing else abs(w) >= 1e-15):
                     out[idx] = math.nan
                     continue
@@ -357,8 +357,8 @@ def glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun_zeni
             continue
         if a_ == 0.0 or b_ == 0.0:
             raise NotImplementedError("glint_radiance needs both rms slopes > 0 (or both 0)")
-        if _is_shifted(mean):
-            den = _shifted_denominator_or_nan(t_, p_, a_, b_, r_, shadowing, 1e-10, "phi_outer",
+        if is_shifted(mean):
+            den = shifted_denominator_or_nan(t_, p_, a_, b_, r_, shadowing, 1e-10, "phi_outer",
                                               mean)
             if den is None:
                 out[idx] = math.nan
@@ -367,7 +367,7 @@ def glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun_zeni
             if not shadowing and t_ == HALF_PI:
                 out[idx] = math.nan
                 continue
-            den = _denominator(t_, p_, a_, b_, r_, shadowing, 1e-10, "phi_outer")
+            den = denominator(t_, p_, a_, b_, r_, shadowing, 1e-10, "phi_outer")
         if g1 == 0.0 or e_ == 0.0 or c[2] <= -math.sin(radius):
             out[idx] = 0.0  # masked, dark, or the whole disk below the horizon
             continue

@@ -21,7 +21,7 @@ import torch
 
 from ..clutter import along_view, two_scale_statistics
 from ..slopes import SlopeStatistics
-from ..sun import _glint, _glint_sharp, sun_masking_factor
+from ..sun import glint_from_moments, glint_sharp_factor, sun_masking_factor
 from .scene import SceneParameters, SeaScene
 from .settings import FINE_OVERHANG, TableSize
 from .sky_terms import relative_sun
@@ -124,7 +124,7 @@ def glint_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: torch.Te
                                                          c_k, at(x)[:, None], var_a, kap,
                                                          visible=None if x_vis is None else at(x_vis)[:, None]))
             (vx, vy, cxy), (mx, my) = shifted.tensors(dtype, device), shifted.mean_tensors(dtype, device)
-        g = _glint(torch.acos(c_k.clamp(-1.0, 1.0)), phi, vx, vy, cxy, mx, my, n_, k_, tz, tp, e_sun, al, scene.shadowing)
+        g = glint_from_moments(torch.acos(c_k.clamp(-1.0, 1.0)), phi, vx, vy, cxy, mx, my, n_, k_, tz, tp, e_sun, al, scene.shadowing)
         if g1 is not None:
             g = g * g1[m]
         if tau_rows is not None:  # the path's transmittance: quadratic through the table's 3 nearest rows
@@ -145,7 +145,7 @@ def glint_table(scene: SeaScene, p: SceneParameters, sl: slice, eps: torch.Tenso
                       y_cols: torch.Tensor, centre: torch.Tensor, shift: float, sea_cols: torch.Tensor,
                       scale_rows: torch.Tensor | None, table: TableSize, dtype: torch.dtype) -> tuple[torch.Tensor, torch.Tensor]:
     """The smooth factor L_sun G1 / D of the glint of images ``sl`` (the glint is P ρ t · L_sun G1 / D,
-    ``roughsea_torch.sun._glint_sharp`` the sharp part, which :func:`glint_sharp_pixels` evaluates per
+    ``roughsea_torch.sun.glint_sharp_factor`` the sharp part, which :func:`glint_sharp_pixels` evaluates per
     pixel) on the fine table's sea rows and unfolded columns (``col_angle``: the azimuth coordinate o of
     column coordinates y ∈ [−1, 1], φ̂ = ``centre`` + o − ``shift``), times ``scale_rows`` (b, M_z)
     (the path's τ, the foam's 1 − f); (b, M_z, M_o), and which images it serves (b,) bool (zero for the
@@ -176,12 +176,12 @@ def glint_table(scene: SeaScene, p: SceneParameters, sl: slice, eps: torch.Tenso
         return th, (centre[:, None] + o - shift).to(dtype)[:, None, :]
 
     def smooth(th: torch.Tensor, ph: torch.Tensor) -> torch.Tensor:
-        r = _glint(th, ph, per[0], per[1], per[2], None, None, per[3], per[4], tz, tp, e_sun, al, scene.shadowing,
+        r = glint_from_moments(th, ph, per[0], per[1], per[2], None, None, per[3], per[4], tz, tp, e_sun, al, scene.shadowing,
                    smooth=True)
         return r if g1 is None else r * g1
 
     def sharp(th: torch.Tensor, ph: torch.Tensor) -> torch.Tensor:
-        return _glint_sharp(torch.cos(th), torch.sin(th), torch.cos(ph), torch.sin(ph), per[0], per[1], per[2], zero, zero,
+        return glint_sharp_factor(torch.cos(th), torch.sin(th), torch.cos(ph), torch.sin(ph), per[0], per[1], per[2], zero, zero,
                             per[3], per[4], tz, tp, al)[0]
 
     n = int(table.glint)
@@ -217,7 +217,7 @@ def glint_table(scene: SeaScene, p: SceneParameters, sl: slice, eps: torch.Tenso
 def glint_sharp_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: torch.Tensor, dx: torch.Tensor,
                         dy: torch.Tensor, sea: torch.Tensor) -> torch.Tensor:
     """P ρ t at the sea pixels that can see glint (:func:`glint_mask`) (b, H, W), 0 elsewhere: the
-    glint's part that is sharp in the view direction (``roughsea_torch.sun._glint_sharp``, the ellipse's probability in closed form or by rays
+    glint's part that is sharp in the view direction (``roughsea_torch.sun.glint_sharp_factor``, the ellipse's probability in closed form or by rays
     as it is small or not), for the pixel's line of sight, whose azimuth in the upwind frame comes from
     the ray's world components: (cos φ̂, sin φ̂) = −(dx, dy)/|(dx, dy)| turned by −wind_direction."""
     dtype, device = cos_t.dtype, cos_t.device
@@ -233,7 +233,7 @@ def glint_sharp_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: to
         cw, sw, vx, vy, cxy, n_, k_, tz, tp, al = (v[m] for v in per_img)
         c = at(cos_t)
         cph, sph = upwind_los(at(dx), at(dy), cw, sw)
-        return _glint_sharp(c, torch.sqrt((1.0 - c * c).clamp_min(0.0)), cph, sph, vx, vy, cxy, zero, zero, n_, k_, tz, tp,
+        return glint_sharp_factor(c, torch.sqrt((1.0 - c * c).clamp_min(0.0)), cph, sph, vx, vy, cxy, zero, zero, n_, k_, tz, tp,
                             al)[0]
 
     return over_kept_pixels(glint_mask(p, sl, sun, cos_t, dx, dy, sea), sharp_factor, dtype)

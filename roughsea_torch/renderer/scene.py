@@ -9,23 +9,21 @@ from __future__ import annotations
 import math
 import threading
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Any
 
 import numpy as np
 import torch
 
-from .._validation import check_finite_range, per_batch
-from ..atmosphere import load_observer_sky, load_path, load_sky, surface_air_temperature
+from .._validation import check_finite_range, parse_seeds, per_batch
+from ..atmosphere import as_sky, load_observer_sky, load_path, load_sky, surface_air_temperature
 from ..daysky import AEROSOLS, load_scattered_sky
 from ..foam import whitecap_fraction
-from ..optics import band_refractive_index, split_refractive_index
+from ..optics import band_index_lookup, split_refractive_index
 from ..radiometry import LWIR, SpectralBand, as_band, band_radiance, brightness_temperature
-from ..sky import as_sky
 from ..slopes import SlopeStatistics
 from ..solar import load_solar_irradiance
 from ..sun import Sun
-from ..waves import MAX_WIND_DIRECTION, WaveField, _seeds, check_time
+from ..waves import MAX_WIND_DIRECTION, WaveField, check_time
 from .settings import TableSize
 
 __all__ = ["SeaScene", "SceneParameters", "check_foam"]
@@ -263,7 +261,7 @@ class SeaScene:
             if wind_speed is None:
                 raise ValueError("seed: a textured sea needs wind_speed= (the wave spectrum is driven by the wind); "
                                  "seed=None renders the expectation image of slopes=")
-            parsed = _seeds(seed)  # WaveField's check: ints in [0, 2**63), numpy integers too
+            parsed = parse_seeds(seed)  # WaveField's check: ints in [0, 2**63), numpy integers too
             seed = parsed.values[0] if parsed.single else list(parsed.values)
         self.time_s = time_s  # checked by its setter
         if sun is not None:
@@ -427,7 +425,7 @@ class SeaScene:
         m = self.refractive_index
         if m is None:  # the band-effective water index at each image's sea temperature (a lookup)
             t_idx = t_sea if self.sea_radiance is None else brightness_temperature(rb.clamp_min(1e-30), self.band)
-            m = _band_index(self.band, t_idx.double())
+            m = band_index_lookup(self.band, t_idx.double())
         n, k = split_refractive_index(m, dtype, device)
         air_scale = None
         if self.air_temperature is not None:  # B(T_air) / B(T_atm): scales sky and path radiance
@@ -448,44 +446,3 @@ class SeaScene:
             foam = None  # no foam anywhere: leave it out
         return SceneParameters(vx=vx, vy=vy, cxy=cxy, wind_direction=wd, rb=rb, n=n.expand(B), k=k.expand(B), sky=self.sky,
                                foam=foam, air_scale=air_scale)
-
-
-_INDEX_T0, _INDEX_DT, _INDEX_NT = 180.0, 2.0, 91  # the band-index table: 180-360 K every 2 K
-
-
-@lru_cache(maxsize=16)
-def _band_index_table(band: SpectralBand) -> tuple[torch.Tensor, torch.Tensor]:
-    """n and k of the band-effective water index at 180–360 K every 2 K, (2, N_T), and their
-    T-derivatives at the nodes, (2, N_T): 4th-order centred differences (2nd-order one-sided at the
-    ends; the fit is smooth in T)."""
-    t = _INDEX_T0 + _INDEX_DT * torch.arange(_INDEX_NT, dtype=torch.float64)
-    m = band_refractive_index(band, t)
-    y = torch.stack([m.real, m.imag])
-    d = torch.empty_like(y)
-    d[:, 2:-2] = (y[:, :-4] - 8 * y[:, 1:-3] + 8 * y[:, 3:-1] - y[:, 4:]) / (12 * _INDEX_DT)
-    d[:, 1], d[:, -2] = (y[:, 2] - y[:, 0]) / (2 * _INDEX_DT), (y[:, -1] - y[:, -3]) / (2 * _INDEX_DT)
-    d[:, 0] = (-3 * y[:, 0] + 4 * y[:, 1] - y[:, 2]) / (2 * _INDEX_DT)
-    d[:, -1] = (3 * y[:, -1] - 4 * y[:, -2] + y[:, -3]) / (2 * _INDEX_DT)
-    return y, d
-
-
-def _band_index(band: SpectralBand, temperature: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-    """The band-effective water index (n, k) at T_sea [K] (a float64 tensor, any shape):
-    ``band_refractive_index`` tabulated every 2 K over 180–360 K per band and read by a cubic
-    Hermite interpolant, differentiable in T (within 1e-8 of the direct fit; a fit costs ~20 ms,
-    a lookup ~0.1 ms). Its T-derivative is the interpolant's, so the gradient of an image with
-    respect to the sea temperature includes how the Planck weights of the band move the index."""
-    try:
-        y, d = _band_index_table(band)
-    except TypeError:  # a band with an unhashable response (e.g. arrays): fit directly
-        m = band_refractive_index(band, temperature)
-        return m.real, m.imag
-    y, d = y.to(temperature.device), d.to(temperature.device)
-    f = ((temperature - _INDEX_T0) / _INDEX_DT).clamp(0.0, _INDEX_NT - 1.0)
-    i = f.detach().floor().long().clamp(max=_INDEX_NT - 2)
-    s = f - i
-    s2, s3 = s * s, s * s * s
-    h00, h10, h01, h11 = 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, 3 * s2 - 2 * s3, s3 - s2
-    out = h00 * y[:, i] + h10 * _INDEX_DT * d[:, i] + h01 * y[:, i + 1] + h11 * _INDEX_DT * d[:, i + 1]
-    return out[0], out[1]
-

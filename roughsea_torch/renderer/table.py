@@ -39,8 +39,8 @@ import torch
 import torch.nn.functional as F
 
 from .._parallel import map_chunks
-from ..expectation import _reflection_terms
-from ..foam import _crest_foam_fraction
+from ..expectation import reflection_terms
+from ..foam import crest_fraction_from_variances
 from ..sky import select_sky
 from ..slopes import SlopeStatistics
 from .coordinates import (ViewSpans, angle_of_ratio, asinh_fast, azimuth_coordinate, azimuth_ratio, camera_spans,
@@ -208,8 +208,8 @@ def mean_at_nodes(plan: RenderPlan, sl: slice, th_nodes: torch.Tensor, ph_nodes:
         sky = sky_per_image(select_sky(p.sky, sl), b_, dtype, plan.device, 2)
     else:  # per azimuth node: the scattered sky along the mirror azimuth
         sky = sky_with_day(select_sky(p.sky, sl), plan.day, p, sl, ph_nodes[:, None, :])
-    t_s, t_rho, _ = _reflection_terms(vz, va, slopes, (p.n[sl, None, None], p.k[sl, None, None]), sky,
-                                      scene.shadowing, plan.quadrature, None, scene.sky_masking)
+    t_s, t_rho = reflection_terms(vz, va, slopes, (p.n[sl, None, None], p.k[sl, None, None]), sky, scene.shadowing,
+                                  plan.quadrature, sky_masking=scene.sky_masking, working_dtype=True)
     if p.air_scale is not None:
         t_s = t_s * p.air_scale[sl, None, None].to(t_s.dtype)
     rb = p.rb[sl, None, None].to(t_s.dtype)
@@ -536,7 +536,7 @@ def per_pixel_terms(plan: RenderPlan, ft: FineTable, rays: PixelRays, vals: torc
         vals = vals + pixel_glint(plan, ft, rays, cos_t, resolved, sl)
     if ft.crest:  # (1 − f_pix) · (sea + texture + glint) + f_pix · foam
         x_r, v_r, v_t = crest_var[0]
-        f_pix = _crest_foam_fraction(x_r, v_r, v_t, p.foam[sl].to(dtype)[:, None, None])
+        f_pix = crest_fraction_from_variances(x_r, v_r, v_t, p.foam[sl].to(dtype)[:, None, None])
         # no foam in the sky: there f_pix would be W, and the lerp would take that share of the
         # sky pixels from the foam channel's sky rows, which lack the day's scattered sky
         # (added to the sky pixels of channel 0 above)

@@ -22,7 +22,7 @@ import torch.nn.functional as F
 
 from .._validation import per_batch
 from ..clutter import along_view, footprint, reconcile_scale, resolved_quantile, two_scale_statistics
-from ..expectation import _reflection_terms
+from ..expectation import reflection_terms
 from ..geometry import slant_range
 from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
@@ -199,10 +199,10 @@ class TextureTable:
             sky_m = sky.with_radiance(sky.radiance[:, 0].to(dtype=dtype, device=device)[im, idx[2][sel]][:, None, :])
         else:
             sky_m = sky_per_image(select_sky(sky_of_chunk(sky, b_), im.cpu()), im.numel(), dtype, device, 1)
-        t_s, t_rho, _ = _reflection_terms(torch.acos(ct[sel].clamp(-1.0, 1.0))[:, None], ph[sel][:, None], stats,
-                                          (p.n[sl][im, None], p.k[sl][im, None]), sky_m, scene.shadowing,
-                                          q.with_(outer=outer, inner=inner, width=min(float(q.width), self.window)),
-                                          None, scene.sky_masking)
+        t_s, t_rho = reflection_terms(torch.acos(ct[sel].clamp(-1.0, 1.0))[:, None], ph[sel][:, None], stats,
+                                      (p.n[sl][im, None], p.k[sl][im, None]), sky_m, scene.shadowing,
+                                      q.with_(outer=outer, inner=inner, width=min(float(q.width), self.window)),
+                                      sky_masking=scene.sky_masking, working_dtype=True)
         if p.air_scale is not None:
             t_s = t_s * p.air_scale[sl][im, None].to(t_s.dtype)
         return t_s, t_rho
@@ -249,7 +249,7 @@ class TextureTable:
         X = cen[:, 0, None, None] + R * dx
         Y = cen[:, 1, None, None] + R * dy
         # (the field's own entry without the input checks: X, Y, L come from the finite geometry)
-        smp = wf._sample(X, Y, self.time[sl], L, elevation=False, crest=crest)
+        smp = wf.sample_unchecked(X, Y, self.time[sl], L, elevation=False, crest=crest)
         gy = (2.0 * (zeta - lo.to(dtype)[:, None, None]) / span_z.to(dtype)[:, None, None] - 1.0) / (1.0 + self.ez)
         cov = self._row_statistics(sl, wf, gy, lo, span_z, h, crest)
         x = resolved_quantile(smp["slope_x"], smp["slope_y"], (cov[:, 0], cov[:, 1], cov[:, 2]), dx, dy)
