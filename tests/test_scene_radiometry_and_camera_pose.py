@@ -120,16 +120,22 @@ def test_camera_roll_tilts_the_horizon_by_the_roll_angle(roll):
 
 
 def test_print_default_config_is_complete_and_valid():
-    """``generate_dataset.py --print-default-config`` prints JSON that equals DEFAULT_CONFIG, passes
-    the config validation as is, and names every key the validation knows (an unknown key is
-    rejected, so a config written from the printout is complete)."""
+    """``generate_dataset.py --print-default-config`` prints TOML, the format ``--config`` reads (it
+    printed JSON, which tomllib refuses: found by a new user), equal to DEFAULT_CONFIG but for the keys
+    whose default is "not set" (TOML has no null: left out, and named in a comment); it passes the
+    config validation as is, and names every key the validation knows (an unknown key is rejected,
+    so a config written from the printout is complete)."""
+    import tomllib
+
     out = subprocess.run([sys.executable, str(ROOT / "pipelines" / "generate_dataset.py"), "--print-default-config"],
                          capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert out.returncode == 0, out.stderr
-    printed = json.loads(out.stdout)
+    printed = tomllib.loads(out.stdout)
     from roughsea_torch.dataset import DEFAULT_CONFIG, resolve_config
 
-    assert printed == json.loads(json.dumps(DEFAULT_CONFIG))
+    assert "scene.air_temperature" in out.stdout.split("\n\n")[0]  # the unset key, named in the header comment
+    printed_unset = {**printed, "scene": {**printed["scene"], "air_temperature": None}}
+    assert printed_unset == json.loads(json.dumps(DEFAULT_CONFIG))
     resolve_config(printed)
     with pytest.raises(ValueError, match="no_such_key"):
         resolve_config({**printed, "no_such_key": 1})
