@@ -21,10 +21,13 @@ Method (the running horizon of height-field renderers, applied to the sea):
   found from cumulative sums and binary searches); the parts of the interval with no resolved surface
   (beyond the sweep) add nothing. Where nothing is resolved the average is exactly 0 (the far field
   keeps the expectation image).
-- Samples run at depressions ``step`` pixels apart, r_k = h tan(atan(r_0/h) + k · step · δ), δ the
-  camera's angular pixel size at its centre; the surface at r_k is filtered at the footprint of that
-  spacing along the view (the waves shorter than it stay statistical, about the resolved slope). Tracks
-  run at azimuths ``1/tracks`` pixel apart; a pixel takes its nearest track.
+- Samples run at depressions s(θ̂) pixels apart (δ the camera's angular pixel size at its centre), and
+  the surface at a sample is filtered at the footprint of twice that spacing along the view, 2 s R δ /
+  cos θ̂ (the waves shorter than it stay statistical, about the resolved slope): s = ``across`` ·
+  cos θ̂ / 2 clamped into [``min_step``, ``step``], so that near grazing, where a pixel's footprint is
+  1/cos θ̂ times longer along the view than across, the samples resolve the waves down to ``across``
+  times its width across (:func:`sample_step`). Tracks run at azimuths ``1/tracks`` pixel apart; a
+  pixel takes its nearest track.
 
 Everything is differentiable in the wind (through η, the slopes and the crest variable) and the pose
 (through t and the pixels' depressions); the choice of samples and elements is not (indices are
@@ -45,11 +48,19 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
 import torch
 
 from ..clutter import footprint
 
-__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "pixel_windows", "visible_average", "centre_element"]
+__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "pixel_windows", "visible_average", "centre_element", "sample_step"]
+
+
+def sample_step(cos_view: Any, step: float, min_step: float, across: float) -> Any:
+    """The sweep's sample spacing [pixels of depression] at a view of zenith cosine ``cos_view``:
+    ``across`` · cos θ̂ / 2 clamped into [``min_step``, ``step``] (a tensor or a numpy array)."""
+    half = 0.5 * across * cos_view
+    return half.clip(min_step, step) if hasattr(half, "clip") else min(max(half, min_step), step)
 
 
 @dataclass
@@ -78,7 +89,7 @@ class Sweep:
 
 
 def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, tan_g: torch.Tensor, phi: torch.Tensor,
-                 ifov: float, earth_radius_m: float, *, step: float, tracks: float, footprint_scale: float,
+                 ifov: float, earth_radius_m: float, *, step: float, min_step: float, across: float, tracks: float,
                  height_sigmas: float = 5.0) -> Sweep | None:
     """The sweep of one image, or None where its sea pixels resolve no wave.
 
@@ -87,8 +98,8 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
         centre: world x, y of the camera [m]; h: its height above the sea [m] (0-D tensor).
         tan_g, phi: the sea pixels' depressions (tangent) and ray azimuths [rad], 1-D.
         ifov: δ, the angular pixel size at the image centre [rad]; earth_radius_m: R [m] (``inf``: flat).
-        step: the samples' spacing in depression, in pixels; tracks: tracks per pixel width.
-        footprint_scale: the samples' footprint, in along-view footprints of a whole pixel (R δ / cos θ̂).
+        step, min_step, across: the samples' spacing in depression, in pixels (:func:`sample_step`);
+            tracks: tracks per pixel width.
         height_sigmas: the resolved elevation's bound, in its standard deviations (the sweep starts where
             the steepest ray may first meet a crest).
     """
@@ -97,21 +108,26 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     hf = float(h.detach())
     k_min = min(field.bands.band_wavenumber)
     l_end = 1.42 * math.pi / k_min  # footprint beyond which no band is resolved (the window's outer edge)
-    d_eff = ifov * footprint_scale
-    r_end = math.sqrt(max(l_end * hf / d_eff - hf * hf, 0.0))  # where δ_eff (r² + h²)/h reaches l_end
+    r_end = math.sqrt(max(l_end * hf / (ifov * 2.0 * min_step) - hf * hf, 0.0))  # the finest sample's reach
     tg = tan_g.detach()
     tg_max, tg_min = float(tg.max()), float(tg.min())
-    sig = float(field.elevation_variance(torch.tensor(d_eff * hf, dtype=torch.float64))[image].sqrt())
+    sig = float(field.elevation_variance(torch.tensor(2.0 * min_step * ifov * hf, dtype=torch.float64))[image].sqrt())
     eta_max = height_sigmas * sig
     r0 = max(0.05, (hf - eta_max) / tg_max) if hf > eta_max else 0.05
     r1 = min(r_end, 1.2 * hf / max(tg_min, 1e-9) + eta_max / max(tg_min, 1e-9))
     if r1 <= r0:
         return None
-    a0, a1 = math.atan(r0 / hf), math.atan(r1 / hf)
-    ns = int(math.ceil((a1 - a0) / (step * ifov))) + 1
+    # depressions γ from the sweep's start to its end, spaced s(θ̂) δ apart (cos θ̂ = sin γ, flat sea):
+    # k(γ) = ∫ dγ / (s δ) on a fine grid, inverted at whole k
+    g_far, g_near = math.atan(hf / r1), math.atan(hf / r0)
+    grid = np.linspace(g_far, g_near, 20001)
+    dk = 1.0 / (ifov * sample_step(np.sin(grid), step, min_step, across))
+    k_of_g = np.concatenate([[0.0], np.cumsum(0.5 * (dk[1:] + dk[:-1]) * np.diff(grid))])
+    ns = int(math.ceil(k_of_g[-1])) + 1
     if ns < 2:
         return None
-    r = hf * torch.tan(a0 + (a1 - a0) * torch.arange(ns, dtype=torch.float64, device=device) / (ns - 1)).to(dtype)
+    gam = np.interp(np.linspace(0.0, k_of_g[-1], ns), k_of_g, grid)[::-1].copy()  # near to far
+    r = torch.as_tensor(hf / np.tan(gam), dtype=dtype, device=device)
     ph = phi.detach()
     p0, p1 = float(ph.min()), float(ph.max())
     dphi = ifov / tracks
@@ -120,7 +136,8 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     x = centre[0].to(dtype) + r[:, None] * torch.cos(az)[None, :]
     y = centre[1].to(dtype) + r[:, None] * torch.sin(az)[None, :]
     rho = torch.sqrt(r * r + hf * hf)
-    fp = footprint(rho, hf / rho, torch.tensor(d_eff, dtype=dtype, device=device))
+    scale = 2.0 * torch.as_tensor(sample_step(np.sin(gam), step, min_step, across), dtype=dtype, device=device)
+    fp = footprint(rho, hf / rho, ifov * scale)
     return Sweep(r, az, x, y, fp, h.to(dtype), curv, p0, dphi)
 
 

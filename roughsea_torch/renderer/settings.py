@@ -83,9 +83,12 @@ class TableSize:
             visible-slope distribution (:func:`~roughsea_torch.clutter.visible_slope`; its ensemble
             mean is the expectation image exactly, but near grazing it has neither parallax nor
             hiding).
-        texture_hit_step, texture_hit_tracks: the sweep of ``texture_hit="first"``: its samples'
-            spacing in depression [pixels] (each filtered at twice that spacing's footprint along the
-            view: the waves it resolves), and its ground tracks per pixel width.
+        texture_hit_step, texture_hit_min_step, texture_hit_across, texture_hit_tracks: the sweep of
+            ``texture_hit="first"``: its samples' spacing in depression [pixels], ``across`` · cos θ̂/2
+            clamped into [``min_step``, ``step``] (each sample filtered at twice its spacing's footprint
+            along the view: near grazing the waves down to ``across`` times the pixel's width across
+            the view; :func:`~roughsea_torch.renderer.hits.sample_step`), and its ground tracks per
+            pixel width.
 
     For accuracy finer than the defaults, e.g. MWIR day skies about the sun:
     ``TableSize(texture_quadrature=(20, 16), texture_azimuth_sun=17, fine_texture_azimuth=64)``.
@@ -114,6 +117,8 @@ class TableSize:
     texture_min_band_share: float = 1e-8
     texture_hit: str = "flat"
     texture_hit_step: float = 0.25
+    texture_hit_min_step: float = 0.03125
+    texture_hit_across: float = 1.0
     texture_hit_tracks: float = 1.0
     texture_azimuth_sun: int = 9
     zenith_narrow: int = 21
@@ -142,7 +147,8 @@ class TableSize:
                 raise ValueError(f"TableSize.{name} must be (outer, inner), two ints in [1, 512]; got {rule!r}")
             object.__setattr__(self, name, tuple(int(v) for v in rule))  # hashable (tables are cached by it)
         for name, lo, hi in (("texture_steep_zenith_deg", 0.0, 90.0), ("texture_quadrature_width", 1.0, 40.0),
-                             ("texture_hit_step", 0.01, 1.0), ("texture_hit_tracks", 0.25, 16.0)):
+                             ("texture_hit_step", 0.01, 1.0), ("texture_hit_min_step", 0.001, 1.0),
+                             ("texture_hit_across", 0.1, 100.0), ("texture_hit_tracks", 0.25, 16.0)):
             v = getattr(self, name)
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real) or not lo <= float(v) <= hi:
                 raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")

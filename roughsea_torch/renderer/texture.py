@@ -27,7 +27,7 @@ from ..expectation import reflection_terms
 from ..geometry import slant_range
 from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
-from .hits import Sweep, centre_element, pixel_windows, sweep_envelope, sweep_layout, visible_average
+from .hits import Sweep, centre_element, pixel_windows, sample_step, sweep_envelope, sweep_layout, visible_average
 from .path import path_rows
 from .scene import SceneParameters
 from .sky_terms import sky_per_image
@@ -84,12 +84,17 @@ class TextureTable:
         self.window = float(table.texture_quadrature_width)
         self.min_band_share = float(table.texture_min_band_share)
         self.first_hit = table.texture_hit == "first"
-        # the sweep (TableSize.texture_hit_step, texture_hit_tracks): samples step pixels apart in depression,
-        # each filtered at its spacing's footprint along the view (twice it), and the volume built for it
-        self.hit_step = float(table.texture_hit_step)
+        # the sweep (TableSize.texture_hit_*): samples s(θ̂) pixels apart in depression, each filtered at
+        # twice its spacing's footprint along the view, and the volume built for those footprints
+        self.hit_steps = dict(step=float(table.texture_hit_step), min_step=float(table.texture_hit_min_step),
+                              across=float(table.texture_hit_across))
         self.hit_tracks = float(table.texture_hit_tracks)
-        self.footprint_scale = 2.0 * self.hit_step if self.first_hit else 1.0
         self.scaled = False  # whether some resolved slopes were scaled down (reconcile_scale)
+
+    def _scale(self, cos_view: torch.Tensor) -> Any:
+        """The footprint of the texture's nodes, in whole pixels' along-view footprints: 1, or with the
+        sweep twice its sample spacing at that view (:func:`~roughsea_torch.renderer.hits.sample_step`)."""
+        return 2.0 * sample_step(cos_view, **self.hit_steps) if self.first_hit else 1.0
 
     def field(self, sl: slice) -> Any:
         """The wave field of images ``sl``."""
@@ -149,7 +154,7 @@ class TextureTable:
         th_nodes = torch.acos((self.eps[sl][:, None] * torch.sinh(zeta)).clamp(0.0, 1.0)).to(dtype)
         h = self.altitude[sl].to(dtype)
         cos_n = torch.cos(th_nodes)
-        L = footprint(slant_range(cos_n, h[:, None], self.earth_radius_m), cos_n, self.ifov[sl, None] * self.footprint_scale)
+        L = footprint(slant_range(cos_n, h[:, None], self.earth_radius_m), cos_n, self.ifov[sl, None] * self._scale(cos_n))
         cov, _ = self.resolved(wf, L, sl)
         cov = tuple(c[:, :, None] for c in cov)  # (b, nz, 1)
         phw = ph_nodes + p.wind_direction[sl, None].to(dtype)  # LOS azimuth in the world
@@ -299,8 +304,7 @@ class TextureTable:
             im = sl.start + i
             wf = self.field(slice(im, im + 1))
             sw = sweep_layout(wf, 0, self.centres[im], self.altitude[im], tan_g, phi, float(self.ifov[im]),
-                              self.earth_radius_m, step=self.hit_step, tracks=self.hit_tracks,
-                              footprint_scale=self.footprint_scale)
+                              self.earth_radius_m, tracks=self.hit_tracks, **self.hit_steps)
             if sw is None:
                 continue
             values, x_k, cov_k, m = self._swept_samples(im, i, wf, sw, vol, lo, span_z, a, b, coordinate, crest)
