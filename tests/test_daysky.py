@@ -43,7 +43,7 @@ T = _table()
 NAMES = [str(n) for n in T["atmospheres"]]
 AEROSOLS = [str(n) for n in T["aerosols"]]
 COMBOS = [(n, a) for n in NAMES for a in AEROSOLS]
-pytestmark = pytest.mark.usefixtures("one_torch_thread")
+pytestmark = pytest.mark.usefixtures("one_thread")
 
 
 _SKIES: dict = {}

@@ -26,35 +26,33 @@ from roughsea_torch.renderer.texture import TextureTable
 from roughsea_torch.foam import crest_foam_fraction, whitecap_fraction
 from roughsea_torch.waves import WaveField
 
+from conftest import torch_threads
+
 WIND = 10.0
 FOOTPRINTS = (0.05, 3.0, 30.0)  # [m] short (everything resolved), medium, long (14 % of X resolved)
 
 
-@pytest.fixture(autouse=True, scope="module")
-def _one_thread():
-    n = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n)
+pytestmark = pytest.mark.usefixtures("one_thread")
 
 
 @pytest.fixture(scope="module")
 def ensemble():
     """120 realizations (one seed each, U10 = 10 m/s, float32) sampled at 2048 uniform random points
     of the longest tile, each point at the three footprints (one call, one pass over the bands)."""
-    n, npts = 120, 2048
-    field = WaveField(torch.full((n,), WIND), list(range(n)), wind_direction=0.4, dtype=torch.float32)
-    gen = torch.Generator().manual_seed(0)
-    side = field.bands.tile_length[0]  # every tile length divides it: uniform on every tile
-    x = (torch.rand(n, npts, generator=gen, dtype=torch.float64) * side).float()
-    y = (torch.rand(n, npts, generator=gen, dtype=torch.float64) * side).float()
-    k = len(FOOTPRINTS)
-    fp = torch.tensor(FOOTPRINTS).repeat_interleave(npts).expand(n, -1)
-    smp = field.sample(x.repeat(1, k), y.repeat(1, k), 1.0, footprint=fp, elevation=True, crest=True)
-    out = {key: v.view(n, k, npts).double() for key, v in smp.items()}
-    for name, var in (("crest", field.crest_variance), ("elevation", field.elevation_variance)):
-        out[name + "_resolved_variance"] = var(fp).view(n, k, npts).double()
-        out[name + "_total_variance"] = var().double()[:, None, None]
+    with torch_threads(1):
+        n, npts = 120, 2048
+        field = WaveField(torch.full((n,), WIND), list(range(n)), wind_direction=0.4, dtype=torch.float32)
+        gen = torch.Generator().manual_seed(0)
+        side = field.bands.tile_length[0]  # every tile length divides it: uniform on every tile
+        x = (torch.rand(n, npts, generator=gen, dtype=torch.float64) * side).float()
+        y = (torch.rand(n, npts, generator=gen, dtype=torch.float64) * side).float()
+        k = len(FOOTPRINTS)
+        fp = torch.tensor(FOOTPRINTS).repeat_interleave(npts).expand(n, -1)
+        smp = field.sample(x.repeat(1, k), y.repeat(1, k), 1.0, footprint=fp, elevation=True, crest=True)
+        out = {key: v.view(n, k, npts).double() for key, v in smp.items()}
+        for name, var in (("crest", field.crest_variance), ("elevation", field.elevation_variance)):
+            out[name + "_resolved_variance"] = var(fp).view(n, k, npts).double()
+            out[name + "_total_variance"] = var().double()[:, None, None]
     return out
 
 

@@ -12,14 +12,6 @@ import torch
 import roughsea_torch as rs
 
 
-@pytest.fixture
-def two_threads():
-    old = torch.get_num_threads()
-    torch.set_num_threads(2)
-    yield
-    torch.set_num_threads(old)
-
-
 def _scene(wind):
     return rs.SeaScene(wind_speed=wind, wind_direction=torch.tensor([0.1, 0.9, 2.0, -1.0]),
                        sea_temperature=torch.tensor([285.0, 290.0, 295.0, 300.0]))
