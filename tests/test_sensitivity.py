@@ -1,5 +1,6 @@
-"""``pixel_derivative`` (per-pixel d image / d parameter) against derivatives known in closed form:
-dL/dT of Planck's law integrated over the band (constants typed in), and d(a w²)/dw."""
+"""``pixel_derivative`` (roughsea_torch.sensitivity: per-pixel d image / d parameter) against
+derivatives known in closed form: dL/dT of Planck's law integrated over the band (constants typed in),
+and d(a w²)/dw; and against central differences of a render, pixel by pixel."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ from scipy import integrate
 
 import roughsea_torch as rs
 
-H, C, KB = 6.62607015e-34, 299792458.0, 1.380649e-23  # CODATA 2018
+from conftest import C, H, KB
 
 
 def dplanck_band_dT(T: float, lo: float = 8e-6, hi: float = 12e-6) -> float:
