@@ -30,6 +30,7 @@ Factories, plain functions to import (``from conftest import make_cams, make_sce
 and parametrize lists can use them too: ``make_cams`` (kornia cameras with the defaults most
 renderer tests use), ``make_scene`` (a ``SeaScene`` with the common wind and sea temperature),
 ``varied_cameras`` (five cameras over the renderer's range), ``gen`` (a seeded CPU generator).
+Skies: ``smooth_sky`` (a cold sky, (1 − cos)⁸) and ``horizon_sky`` ((1 − cos)⁴, the textured seas').
 """
 
 from __future__ import annotations
@@ -169,6 +170,11 @@ TIME_RANGE = r"\[-1e\+09, 1e\+09\] s"
 def smooth_sky(c: Any) -> Any:
     """A cold, smooth sky rising towards the sea temperature at the horizon [W m⁻² sr⁻¹]."""
     return 11.0 + 19.0 * (1.0 - c) ** 8
+
+
+def horizon_sky(c: Any) -> Any:
+    """The textured-sea tests' sky: 10 W m⁻² sr⁻¹ at the zenith, 30 at the horizon, (1 − cos)⁴."""
+    return 10.0 + 20.0 * (1.0 - c) ** 4
 
 
 def planck_band(T: float, lo: float, hi: float, response=None) -> float:
