@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 import torch
 
+from roughsea_torch import dataset as D
 from roughsea_torch.augmentation import SceneSampler, render_parameters
 from roughsea_torch.dataset import (
     SeaShardDataset,
@@ -366,3 +367,15 @@ def test_foam_off_in_the_config_reaches_the_shards(tmp_path):
         resolve_config(dict(CFG, scene=dict(CFG["scene"], foam=1.5)))
     with pytest.raises(ValueError, match="scene.foam: one setting for every image"):
         resolve_config(dict(CFG, scene=dict(CFG["scene"], foam=[0.1, 0.2])))
+
+
+def test_frame_render_parameters_docstring_matches_its_result():
+    """The docstring promised an "atmosphere_name" key the result never had."""
+    meta = {name: 1.0 for name, *_r in D.SCENE_FIELDS}
+    meta.update(atmosphere="midlatitude_summer", noise_seed=np.int64(9), wave_seed=np.int64(4), time_s=2.5)
+    p = D.frame_render_parameters(meta)
+    doc = D.frame_render_parameters.__doc__
+    assert "atmosphere" not in p and "atmosphere_name" not in doc
+    assert 'meta["atmosphere"]' in doc
+    for key in set(p) - {name for name, *_r in D.SCENE_FIELDS}:
+        assert f"``{key}``" in doc, key

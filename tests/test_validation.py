@@ -18,6 +18,7 @@ import pytest
 import torch
 
 import roughsea_torch as rs
+from roughsea_torch._validation import check_finite_range
 
 from conftest import M10
 
@@ -110,3 +111,11 @@ def test_per_image_arguments():
         per_batch("x", torch.ones(2), 3, F, cpu)
     with pytest.raises(ValueError, match="x"):
         per_batch("x", torch.ones(3, 1), 3, F, cpu)
+
+
+def test_check_finite_range_names_non_numeric_and_complex_input():
+    for x in ("a", ["a"], np.array(["a"]), [[1.0, 2.0], [3.0]]):
+        with pytest.raises(ValueError, match=r"^x must be a real number or a tensor of real numbers"):
+            check_finite_range("x", x)
+    with pytest.raises(ValueError, match=r"^x must be real"):  # the imaginary part used to be dropped
+        check_finite_range("x", np.array([1.0 + 1.0j]))

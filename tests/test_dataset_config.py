@@ -1,0 +1,29 @@
+"""The dataset generator's config (roughsea_torch.dataset_config): the printed default config is
+complete and valid; the shipped configs resolve."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_print_default_config_is_complete_and_valid():
+    """``generate_dataset.py --print-default-config`` prints JSON that equals DEFAULT_CONFIG, passes
+    the config validation as is, and names every key the validation knows (an unknown key is
+    rejected, so a config written from the printout is complete)."""
+    out = subprocess.run([sys.executable, str(ROOT / "pipelines" / "generate_dataset.py"), "--print-default-config"],
+                         capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert out.returncode == 0, out.stderr
+    printed = json.loads(out.stdout)
+    from roughsea_torch.dataset import DEFAULT_CONFIG, resolve_config
+
+    assert printed == json.loads(json.dumps(DEFAULT_CONFIG))
+    resolve_config(printed)
+    with pytest.raises(ValueError, match="no_such_key"):
+        resolve_config({**printed, "no_such_key": 1})
