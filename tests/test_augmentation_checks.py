@@ -8,10 +8,12 @@ import pytest
 import torch
 
 import roughsea_torch as rs
+from roughsea_torch.augmentation import RandomSeaBackground
 
 from conftest import TIME_RANGE
 
-H, W = 8, 10
+H, W = 8, 10  # the replayed draws' images
+H_IN, W_IN = 24, 32  # the input checks' images
 
 
 def _background_and_draw():
@@ -77,3 +79,25 @@ def test_replayed_clip_params_are_checked():
         aug(x, params=dict(params, time_s=torch.tensor([float("inf"), 0.0], dtype=torch.float64)))
     with pytest.raises(ValueError, match=r"params\['batch_prob'\]: must hold 2 values"):
         aug(x, params=dict(params, batch_prob=torch.ones(1)))
+
+
+@pytest.mark.parametrize("dtype", [torch.float16, torch.bfloat16])
+@pytest.mark.parametrize("mode", ["replace", "composite"])
+def test_half_precision_input_is_refused(dtype, mode):
+    """float16 steps are 0.25 K near 290 K (rounding by up to 0.125 K, against a 0.05 K NETD) and hold integers
+    exactly only to 2048: the output cannot carry the result in the input's dtype."""
+    assert float(torch.tensor(290.0, dtype=torch.float16).nextafter(torch.tensor(300.0, dtype=torch.float16)) - 290.0) == 0.25
+    x = torch.zeros(1, 2 if mode == "composite" else 1, H_IN, W_IN, dtype=dtype)
+    with pytest.raises(ValueError, match=r"input: dtype .*float32"):
+        RandomSeaBackground(mode=mode, output="brightness_temperature")(x)
+
+
+@pytest.mark.parametrize("bad", [2.0, -0.1, float("nan")])
+def test_alpha_outside_the_unit_interval_is_refused(bad):
+    x = torch.zeros(2, 2, H_IN, W_IN)
+    x[:, 0] = 300.0
+    x[1, 1, 3, 4] = bad
+    with pytest.raises(ValueError, match=r"alpha \(input channel 1.*\[0, 1\]"):
+        RandomSeaBackground(mode="composite", output="radiance")(x)
+    x[1, 1, 3, 4] = 1.0  # the edges of the range are fine
+    RandomSeaBackground(mode="composite", output="radiance")(x)

@@ -92,7 +92,8 @@ def test_ensemble_mean_equals_the_expectation_image_row_by_row():
     B, H = 320, 48
     table = rs.TableSize(zenith=13, azimuth=5, texture=7)
     cams = make_cams(H, 12, hfov_deg=8.0, altitude_m=10.0, pitch_deg=-7.0, batch_size=64)
-    img = torch.cat([rs.render(cams, make_scene(sky=horizon_sky, path=False, seed=list(range(1000 + i, 1064 + i))), table=table)[:, 0] for i in range(0, B, 64)])
+    img = torch.cat([rs.render(cams, make_scene(sky=horizon_sky, path=False, seed=list(range(1000 + i, 1064 + i))),
+                               table=table)[:, 0] for i in range(0, B, 64)])
     mean = rs.render(make_cams(H, 12, hfov_deg=8.0, altitude_m=10.0, pitch_deg=-7.0, batch_size=1),
                      make_scene(sky=horizon_sky, path=False, seed=None), table=table)[0, 0]
     g = rs.view_geometry(make_cams(H, 12, hfov_deg=8.0, altitude_m=10.0, pitch_deg=-7.0, batch_size=1))

@@ -218,15 +218,6 @@ def test_day_metadata_reproduces_each_image(tmp_path):
         assert torch.equal(c[0].round(), img)
 
 
-def test_mwir_day_config_resolves():
-    import tomllib
-
-    cfg = resolve_config(tomllib.loads((ROOT / "pipelines" / "configs" / "sea_mwir_day.toml").read_text()))
-    sc = cfg["scene"]
-    assert sc["band"] == "MWIR" and sc["daytime"] > 0 and sc["sun_elevation_deg"] == [3.0, 40.0]
-    assert sc["sun_azimuth_deg"] == [-60.0, 60.0] and sc["sun_azimuth_relative_to_yaw"] is True
-
-
 def test_reader_splits_over_workers_and_converts_to_radiance(reference):
     ds = SeaShardDataset(reference, radiance=True)
     assert len(ds) == 7

@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from roughsea_torch.dataset_config import resolve_config
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -27,3 +29,12 @@ def test_print_default_config_is_complete_and_valid():
     resolve_config(printed)
     with pytest.raises(ValueError, match="no_such_key"):
         resolve_config({**printed, "no_such_key": 1})
+
+
+def test_mwir_day_config_resolves():
+    import tomllib
+
+    cfg = resolve_config(tomllib.loads((ROOT / "pipelines" / "configs" / "sea_mwir_day.toml").read_text()))
+    sc = cfg["scene"]
+    assert sc["band"] == "MWIR" and sc["daytime"] > 0 and sc["sun_elevation_deg"] == [3.0, 40.0]
+    assert sc["sun_azimuth_deg"] == [-60.0, 60.0] and sc["sun_azimuth_relative_to_yaw"] is True

@@ -105,5 +105,6 @@ def test_render_errors(call, match):
 
 @pytest.mark.parametrize("chunk", [0, -1, 1.5, True, "2"])
 def test_render_chunk_must_be_a_positive_int(chunk):
+    cams = make_cams(8, 10, batch_size=1, altitude_m=15.0, dtype=torch.float32)
     with pytest.raises(ValueError, match=r"^chunk must be None or an int in \[1, inf\)"):
-        rs.render(make_cams(8, 10, batch_size=1, altitude_m=15.0, dtype=torch.float32), make_scene(seed=None), chunk=chunk)
+        rs.render(cams, make_scene(seed=None), chunk=chunk)

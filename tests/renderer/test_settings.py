@@ -19,7 +19,8 @@ def test_texture_rules_accept_lists_and_numpy_numbers():
     t = rs.TableSize(texture_quadrature=[20, 16], texture_quadrature_steep=(np.int64(16), 16),
                      texture_quadrature_width=np.float32(4.5))
     assert t.texture_quadrature == (20, 16) and t.texture_quadrature_steep == (16, 16)
-    assert torch.isfinite(rs.render(make_cams(8, 10, batch_size=1, altitude_m=15.0, dtype=torch.float32), make_scene(seed=1), table=t)).all()
+    cams = make_cams(8, 10, batch_size=1, altitude_m=15.0, dtype=torch.float32)
+    assert torch.isfinite(rs.render(cams, make_scene(seed=1), table=t)).all()
     for bad in (dict(texture_quadrature=(0, 16)), dict(texture_quadrature=(2.5, 16)), dict(texture_quadrature_width=0.5)):
         with pytest.raises(ValueError, match=f"TableSize.{next(iter(bad))}"):
             rs.TableSize(**bad)

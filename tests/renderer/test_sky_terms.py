@@ -15,21 +15,6 @@ import roughsea_torch as rs
 from conftest import make_cams, make_scene, smooth_sky
 
 
-def test_the_suns_disk_in_the_sky_carries_its_irradiance():
-    """A narrow camera looking at the sun 3° above the horizon: the disk's radiance summed over the
-    sky pixels' solid angles is E_sun (1 %), and the table render equals the per-pixel one."""
-    cams = make_cams(128, 160, hfov_deg=3.0, pitch_deg=3.0)
-    sun = rs.Sun(math.radians(87.0), 0.0, 12.0)
-    scene = make_scene(wind_speed=6.0, band=rs.MWIR, sun=sun)
-    img = rs.render(cams, scene)
-    night = rs.render(cams, make_scene(wind_speed=6.0, band=rs.MWIR))
-    sky = ~rs.view_geometry(cams).is_sea[0]
-    total = float(((img - night)[0, 0] * sky).sum()) / float(cams.fx[0]) ** 2  # pixel solid angle ≈ 1/f² here
-    assert abs(total / 12.0 - 1) < 0.01
-    direct = rs.render(cams, scene, method="direct")
-    assert float(((img - direct) / direct).abs().max()) < 1e-5
-
-
 def test_sky_pixels_see_the_sky_along_their_ray():
     cams = make_cams(40, 40, hfov_deg=40.0, pitch_deg=15.0)
     scene = make_scene(wind_speed=5.0, sky=smooth_sky)
@@ -144,3 +129,18 @@ def test_day_scene_table_equals_per_pixel_evaluation():
                         sea_temperature=291.0, band=rs.MWIR, sun_zenith=math.radians(70.0), sun_azimuth=0.0, aerosol=None)
     table, direct = rs.render(cams, clear), rs.render(cams, clear, geometry=g, method="direct")
     assert float(((table - direct) / direct).abs().max()) < 2e-5
+
+
+def test_the_suns_disk_in_the_sky_carries_its_irradiance():
+    """A narrow camera looking at the sun 3° above the horizon: the disk's radiance summed over the
+    sky pixels' solid angles is E_sun (1 %), and the table render equals the per-pixel one."""
+    cams = make_cams(128, 160, hfov_deg=3.0, pitch_deg=3.0)
+    sun = rs.Sun(math.radians(87.0), 0.0, 12.0)
+    scene = make_scene(wind_speed=6.0, band=rs.MWIR, sun=sun)
+    img = rs.render(cams, scene)
+    night = rs.render(cams, make_scene(wind_speed=6.0, band=rs.MWIR))
+    sky = ~rs.view_geometry(cams).is_sea[0]
+    total = float(((img - night)[0, 0] * sky).sum()) / float(cams.fx[0]) ** 2  # pixel solid angle ≈ 1/f² here
+    assert abs(total / 12.0 - 1) < 0.01
+    direct = rs.render(cams, scene, method="direct")
+    assert float(((img - direct) / direct).abs().max()) < 1e-5
