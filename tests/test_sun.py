@@ -1,6 +1,7 @@
 """The reflected sun in the expectation (roughsea_torch.sun): Cox & Munk's glitter formula where the
 slopes are broad, a mirror on a flat sea, energy conservation over all view directions, finite
-gradients on a calm sea, and float32/float64 agreement."""
+gradients on a calm sea, float32/float64 agreement, and the numpy reference. (The glint in renders:
+tests/renderer/test_glint.py; of the two-scale sea: tests/test_clutter.py.)"""
 
 import math
 
@@ -184,10 +185,6 @@ def test_bad_sun_is_a_value_error():
         rs.Sun(0.5, 0.0, -1.0)
     with pytest.raises(ValueError, match="sun"):
         rs.apparent_radiance(1.0, 0.0, rs.SlopeStatistics.cox_munk(5.0), M, sea_radiance=30.0, sky=10.0, sun=(0.5, 0.0, 10.0))
-
-
-def _sunny_scene(sun, **kw):
-    return rs.SeaScene(wind_speed=torch.tensor([5.0, 10.0]), sea_temperature=290.0, band=rs.MWIR, sun=sun, **kw)
 
 
 # ------------------------------------------------------------------------------------------------
