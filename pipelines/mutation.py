@@ -43,31 +43,48 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 PKG = "roughsea_torch"
 
-CORE = ["tests/test_published_values.py", "tests/test_model_physics.py", "tests/test_torch_core.py"]
-# module → test files, fastest and most discriminating first (``-x`` stops at the first failure)
+# the physics core: where test_published_values.py, test_model_physics.py and test_torch_core.py went
+CORE = ["tests/test_expectation.py", "tests/test_optics.py", "tests/test_slopes.py", "tests/test_radiometry.py",
+        "tests/test_sky.py", "tests/test_atmosphere.py", "tests/test_validation.py", "tests/test_quadrature.py"]
+# the renderer's files that hold test_render.py's tests (and test_geometry.py, test_sensitivity.py)
+RENDER = ["tests/renderer/test_scene.py", "tests/renderer/test_api.py", "tests/test_geometry.py",
+          "tests/renderer/test_pixels.py", "tests/renderer/test_sky_terms.py", "tests/renderer/test_table.py",
+          "tests/renderer/test_path.py", "tests/test_sensitivity.py", "tests/renderer/test_coordinates.py",
+          "tests/renderer/test_output.py"]
+
+
+def _first(own: str, files: list[str]) -> list[str]:
+    return [own] + [f for f in files if f != own]
+
+
+# module → test files, the module's own first, then those that exercise it (``-x`` stops at the first failure)
 TESTS: dict[str, list[str]] = {
-    "slopes": CORE + ["tests/test_reference_skies_and_indices.py", "tests/test_stability.py", "tests/test_agreement.py"],
-    "optics": CORE + ["tests/test_reference_skies_and_indices.py", "tests/test_stability.py", "tests/test_agreement.py"],
-    "radiometry": ["tests/test_published_values.py", "tests/test_brightness_temperature_lookup.py", "tests/test_model_physics.py",
-                   "tests/test_torch_core.py", "tests/test_stability.py", "tests/test_pixel_derivative.py",
-                   "tests/test_reference_skies_and_indices.py", "tests/test_numpy_input_dtype.py"],
-    "expectation": CORE + ["tests/test_reference_skies_and_indices.py", "tests/test_stability.py", "tests/test_agreement.py"],
-    "_validation": CORE + ["tests/test_numpy_input_dtype.py", "tests/test_stability.py"],
-    "sensitivity": ["tests/test_pixel_derivative.py", "tests/test_render.py"],
-    "reference/planck": ["tests/test_published_values.py", "tests/test_model_physics.py", "tests/test_reference_skies_and_indices.py"],
-    "reference/fresnel": ["tests/test_published_values.py", "tests/test_model_physics.py", "tests/test_agreement.py"],
-    "reference/slopes": ["tests/test_published_values.py", "tests/test_model_physics.py", "tests/test_agreement.py"],
-    "reference/rough_sea": ["tests/test_published_values.py", "tests/test_model_physics.py",
-                            "tests/test_reference_skies_and_indices.py", "tests/test_agreement.py"],
-    "render": ["tests/test_scene_radiometry_and_camera_pose.py", "tests/test_render.py", "tests/test_augmentation.py"],
-    "geometry": ["tests/test_scene_radiometry_and_camera_pose.py", "tests/test_render.py"],
-    "sky": ["tests/test_torch_core.py", "tests/test_reference_skies_and_indices.py", "tests/test_render.py", "tests/test_atmosphere.py"],
-    "atmosphere": ["tests/test_atmosphere.py", "tests/test_observer_sky.py", "tests/test_reference_skies_and_indices.py",
-                   "tests/test_render.py"],
+    "slopes": _first("tests/test_slopes.py", CORE) + ["tests/test_sun.py"],
+    "optics": _first("tests/test_optics.py", CORE) + ["tests/test_sun.py"],
+    "radiometry": _first("tests/test_radiometry.py", CORE) + ["tests/test_sensitivity.py"],
+    "expectation": _first("tests/test_expectation.py", CORE) + ["tests/test_sun.py"],
+    "_validation": _first("tests/test_validation.py", CORE),
+    "sensitivity": _first("tests/test_sensitivity.py", RENDER),
+    "reference/planck": ["tests/test_radiometry.py", "tests/test_expectation.py", "tests/test_optics.py",
+                         "tests/test_slopes.py"],
+    "reference/fresnel": ["tests/test_optics.py", "tests/test_expectation.py", "tests/test_slopes.py",
+                          "tests/test_radiometry.py", "tests/test_sun.py"],
+    "reference/slopes": ["tests/test_slopes.py", "tests/test_expectation.py", "tests/test_optics.py",
+                         "tests/test_radiometry.py", "tests/test_sun.py"],
+    "reference/rough_sea": ["tests/reference/test_rough_sea.py", "tests/test_expectation.py", "tests/test_optics.py",
+                            "tests/test_slopes.py", "tests/test_radiometry.py", "tests/test_sun.py"],
+    "render": RENDER + ["tests/test_dataset_config.py", "tests/test_augmentation.py", "tests/test_sampling.py",
+                        "tests/test_augmentation_checks.py", "tests/test_parameter_render.py"],
+    "geometry": _first("tests/test_geometry.py", RENDER) + ["tests/test_dataset_config.py"],
+    "sky": _first("tests/test_sky.py", CORE) + RENDER + ["tests/test_lowtran.py"],
+    "atmosphere": ["tests/test_atmosphere.py", "tests/test_lowtran.py", "tests/test_observer_sky.py",
+                   "tests/test_expectation.py", "tests/test_radiometry.py"] + RENDER,
     "_parallel": ["tests/test_parallel.py"],
-    "augmentation": ["tests/test_augmentation.py"],
-    "sensor": ["tests/test_sensor.py"],
-    "dataset": ["tests/test_dataset.py", "tests/test_scene_radiometry_and_camera_pose.py"],
+    "augmentation": ["tests/test_augmentation.py", "tests/test_sampling.py", "tests/test_augmentation_checks.py",
+                     "tests/test_parameter_render.py"],
+    "sensor": ["tests/test_sensor.py", "tests/test_sensor_noise.py"],
+    "dataset": ["tests/test_dataset.py", "tests/test_dataset_config.py", "tests/renderer/test_scene.py",
+                "tests/test_geometry.py"],
 }
 MODULE_ALIASES = {"reference": ["reference/planck", "reference/fresnel", "reference/slopes", "reference/rough_sea"],
                   "reference/*": ["reference/planck", "reference/fresnel", "reference/slopes", "reference/rough_sea"]}
