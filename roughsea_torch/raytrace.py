@@ -251,13 +251,14 @@ class TracedSurface:
         if self.n_traced == 0:
             z = torch.zeros_like(x)
             return z, z, z
+        xy = torch.stack([x, y], -1)[:, None]  # (B, 1, P, 2)
         acc = None
         for o, tile in enumerate(self._tiles):
-            length = self.field.bands.tile_length[o]
-            grid = torch.stack([torch.remainder(x, length), torch.remainder(y, length)], -1) * (2.0 / length) - 1.0
-            val = torch.nn.functional.grid_sample(tile, grid[:, None], mode="bilinear", padding_mode="border",
+            grid = xy * (2.0 / self.field.bands.tile_length[o])
+            grid = torch.remainder(grid, 2.0, out=grid).sub_(1.0)  # (x mod L) / L mapped to [−1, 1)
+            val = torch.nn.functional.grid_sample(tile, grid, mode="bilinear", padding_mode="border",
                                                   align_corners=True)[:, :, 0]  # (B, 3, P)
-            acc = val if acc is None else acc + val
+            acc = val if acc is None else acc.add_(val)
         return acc[:, 0], acc[:, 1], acc[:, 2]
 
 
