@@ -1,17 +1,20 @@
 """The brute-force ray tracer (``roughsea_torch.raytrace``): first hits, bounds, radiometric identities.
 
-Plants tried once each (the code edited, the test run and seen to fail, the edit reverted):
-- the march taking the *last* crossing before the slab's bottom instead of the first
-  (``march_first_hits`` kept marching after g ≤ 0 and bracketed the last crossing):
-  ``test_first_hit_behind_a_crest`` fails (hits 3–25 m beyond the analytic point);
-- the hit replaced by the flat-sea point (the renderer's choice): ``test_first_hit_behind_a_crest``
-  and ``test_hit_facets_face_the_camera`` fail (a third of the flat-sea facets face away at 10 m/s);
+Plants tried once each (the code edited, the tests run and seen to fail, the edit reverted):
+- the march bracketing the *last* crossing into the surface before the slab's bottom instead of the
+  first: ``test_first_hit_behind_a_crest`` (hit 37 m beyond the analytic point) and
+  ``test_first_hit_of_descending_rays_on_a_face`` fail;
+- the hit replaced by the flat-sea point (what the renderer samples): ``test_first_hit_behind_a_crest``
+  (18.6 m off) and ``test_hit_facets_face_the_camera`` (27 % of the facets face away) fail;
 - a mirrored ray that points into the sea taking the sky at its (negative) cos zenith instead of R_B
-  (``_specular``): ``test_rays_into_the_sea_never_see_the_sky`` fails;
+  (``_specular``): ``test_rays_into_the_sea_never_see_the_sky`` fails (2222 against R_B = 32.5);
 - the sub-pixel points stratified (one per sub-square of the pixel) instead of i.i.d.:
-  ``test_sampling_variance_estimates_the_noise`` fails (ratio 0.3: the per-pixel variance over
-  rays then overstates the noise of the mean);
-- the Lipschitz bound halved (``TracedSurface._bounds``): ``test_bounds_hold`` fails.
+  ``test_sampling_variance_estimates_the_noise`` fails (ratio 0.24: the per-pixel variance over rays
+  then overstates the noise of the mean);
+- the Lipschitz bound halved (``TracedSurface._bounds``):
+  ``test_traced_surface_is_the_fields_bands_and_bounds_hold`` fails (finite-difference gradients
+  above it). ``test_bounds_hold`` does not catch that one: the sum of the bands' largest gradients is
+  2–4× the surface's largest, which is what it also checks (the bound is not wild).
 """
 
 from __future__ import annotations
@@ -219,14 +222,15 @@ def test_same_scene_as_the_renderer():
 
 def test_sampling_variance_estimates_the_noise():
     """radiance_var / S is the sampling variance of a pixel's mean: two ray seeds differ by about
-    √(2 radiance_var / S) (i.i.d. sub-pixel points), over 192 pixels."""
-    cams = rs.make_camera(12, 16, hfov_deg=2.0, altitude_m=15.0, pitch_deg=-10.0)
+    √(2 radiance_var / S) (i.i.d. sub-pixel points), over 768 pixels looking down at 45°, where a pixel
+    spans a few short waves (stratified points would make the noise of the mean 2–3× smaller than that)."""
+    cams = rs.make_camera(24, 32, hfov_deg=4.0, altitude_m=15.0, pitch_deg=-45.0)
     a = rt.raytraced_image(cams, 10.0, seed=11, rays_per_pixel=4, ray_seed=1)
     b = rt.raytraced_image(cams, 10.0, seed=11, rays_per_pixel=4, ray_seed=2)
     diff = (a["radiance"] - b["radiance"]).double()
     expected = (a["radiance_var"] + b["radiance_var"]).double() / 4
     ratio = float((diff**2).mean() / expected.mean())
-    assert 0.7 < ratio < 1.4, ratio
+    assert 0.75 < ratio < 1.3, ratio
 
 
 def test_dtypes_and_checks():
