@@ -124,6 +124,10 @@ class Surface(Protocol):
         dtype, device: of the positions it takes.
 
     Calling it with x, y (B, P) [m] returns (η [m], s_x, s_y), each (B, P), s = −∇η.
+
+    Optionally (a surface that is a sum of parts, as :class:`TracedSurface`), for sharper steps:
+    ``partial_elevations(x, y)`` → (B, K, P) the partial sums η_{≤j} of its K parts (the last is η),
+    with ``level_slack`` (B, K) [m] ≥ |η − η_{≤j}| and ``level_lipschitz`` (B, K) ≥ |∇η_{≤j}|.
     """
 
     eta_max: torch.Tensor
@@ -171,6 +175,7 @@ class TracedSurface:
             zero = torch.zeros(B, dtype=self.dtype, device=self.device)
             self.traced_covariance = torch.zeros(B, 3, dtype=self.dtype, device=self.device)
             self.eta_max, self.lipschitz = zero, zero.clone()
+            self.level_slack, self.level_lipschitz = zero[:, None], zero[:, None].clone()
             return
         f = torch.zeros((), dtype=self.dtype) if self.footprint is None else torch.tensor(self.footprint, dtype=self.dtype)
         weights = field.band_weights(f.to(self.device)).detach().cpu()
@@ -183,7 +188,12 @@ class TracedSurface:
         cov = field.resolved_covariance(f.to(self.device))
         self.traced_covariance = torch.stack(cov, -1).detach()
         self._tiles = self._read_tiles()
-        self.eta_max, self.lipschitz = self._bounds()
+        self._elevation_tiles = [t[:, :1].contiguous() for t in self._tiles]
+        band_eta, band_lip = self._bounds()
+        self.eta_max, self.lipschitz = band_eta.sum(1), band_lip.sum(1)
+        self.level_lipschitz = band_lip.cumsum(1)  # L of the bands ≤ j
+        rest = band_eta.sum(1, keepdim=True) - band_eta.cumsum(1)  # η_max of the bands > j
+        self.level_slack = torch.where(rest > 0, rest * (1.0 + 1e-9) + 1e-12, torch.zeros_like(rest))
 
     def _selecting_footprint(self, last: int) -> float | None:
         """Footprint [m] at which the window is exactly 1 for bands ≤ ``last`` and exactly 0 above
@@ -223,15 +233,15 @@ class TracedSurface:
         return tiles
 
     def _bounds(self) -> tuple[torch.Tensor, torch.Tensor]:
-        """(η_max, L), each (B,): sums over the traced bands of max |node| and of the largest gradient
-        of the bilinear interpolant (its |∇|² is convex on a cell, so a corner of a cell holds it)."""
+        """Per traced band, (B, K) each: max |node| (the bilinear interpolant's largest |η|) and the
+        largest gradient of the interpolant (its |∇|² is convex on a cell, so a corner of a cell holds
+        it), with a relative margin far above the rounding of the subtraction and interpolation."""
         B, n = self.field.batch_size, self.field.bands.tile_size
-        eta_max = torch.zeros(B, dtype=self.dtype, device=self.device)
-        lip = torch.zeros(B, dtype=self.dtype, device=self.device)
+        etas, lips = [], []
         for o, tile in enumerate(self._tiles):
             h = self.field.bands.tile_length[o] / n
             ext = tile[:, 0]  # (B, n+1, n+1) elevation
-            eta_max += ext.abs().amax((1, 2))
+            etas.append(ext.abs().amax((1, 2)))
             dx = (ext[:, :, 1:] - ext[:, :, :-1]) / h  # (B, n+1, n): along x, at rows j
             dy = (ext[:, 1:] - ext[:, :-1]) / h  # (B, n, n+1): along y, at columns i
             best = torch.zeros(B, dtype=self.dtype, device=self.device)
@@ -240,9 +250,20 @@ class TracedSurface:
                     gxa = dx[:, a : a + n, :]  # ∂x at the cell's row j + a
                     gyb = dy[:, :, b : b + n]  # ∂y at the cell's column i + b
                     best = torch.maximum(best, (gxa**2 + gyb**2).sqrt().amax((1, 2)))
-            lip += best
-        # rounding of the subtraction and of the interpolation: a relative margin far above it
-        return eta_max * (1.0 + 1e-9) + 1e-12, lip * (1.0 + 1e-9) + 1e-12
+            lips.append(best)
+        margin = lambda v: torch.stack(v, 1) * (1.0 + 1e-9) + 1e-12  # noqa: E731
+        return margin(etas), margin(lips)
+
+    def _lookup(self, tiles: list[torch.Tensor], x: torch.Tensor, y: torch.Tensor) -> list[torch.Tensor]:
+        """Each band's bilinear interpolation at (x mod L_o, y mod L_o): a (B, C, P) tensor per band."""
+        xy = torch.stack([x, y], -1)[:, None]  # (B, 1, P, 2)
+        out = []
+        for o, tile in enumerate(tiles):
+            grid = xy * (2.0 / self.field.bands.tile_length[o])
+            grid = torch.remainder(grid, 2.0, out=grid).sub_(1.0)  # (x mod L) / L mapped to [−1, 1)
+            out.append(torch.nn.functional.grid_sample(tile, grid, mode="bilinear", padding_mode="border",
+                                                       align_corners=True)[:, :, 0])
+        return out
 
     def __call__(self, x: torch.Tensor, y: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """(η [m], s_x, s_y) of the traced bands at world points x, y (B, P) [m]: the bilinear
@@ -251,15 +272,14 @@ class TracedSurface:
         if self.n_traced == 0:
             z = torch.zeros_like(x)
             return z, z, z
-        xy = torch.stack([x, y], -1)[:, None]  # (B, 1, P, 2)
-        acc = None
-        for o, tile in enumerate(self._tiles):
-            grid = xy * (2.0 / self.field.bands.tile_length[o])
-            grid = torch.remainder(grid, 2.0, out=grid).sub_(1.0)  # (x mod L) / L mapped to [−1, 1)
-            val = torch.nn.functional.grid_sample(tile, grid, mode="bilinear", padding_mode="border",
-                                                  align_corners=True)[:, :, 0]  # (B, 3, P)
-            acc = val if acc is None else acc.add_(val)
+        acc = sum(self._lookup(self._tiles, x, y))
         return acc[:, 0], acc[:, 1], acc[:, 2]
+
+    def partial_elevations(self, x: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
+        """(B, K, P) [m]: η of the traced bands ≤ j at x, y (B, P), j = 0 … K − 1 (the last is η)."""
+        if self.n_traced == 0:
+            return torch.zeros_like(x)[:, None]
+        return torch.cat(self._lookup(self._elevation_tiles, x, y), 1).cumsum(1)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -367,17 +387,26 @@ def march_first_hits(
     safe_dz = torch.where(down, dz, torch.full_like(dz, -1.0))
     t_top = (C[:, 2:3] - eta_max[:, None]) / (-safe_dz)
     t_bot = (C[:, 2:3] + eta_max[:, None]) / (-safe_dz)
-    rate = -safe_dz + lip[:, None] * torch.sqrt((1.0 - dz * dz).clamp_min(0.0))
+    horizontal = torch.sqrt((1.0 - dz * dz).clamp_min(0.0))
+    levels = hasattr(surface, "partial_elevations")
+    if levels:  # step bounds from every partial sum η_{≤j}: its gap less the rest's amplitude, its own L
+        slack, lip_j = surface.level_slack.to(dt), surface.level_lipschitz.to(dt)  # (B, K)
+    else:
+        slack, lip_j = torch.zeros_like(lip)[:, None], lip[:, None]
 
     out_t = torch.full((B, N), math.inf, dtype=dt, device=dev)
     steps = torch.zeros((B, N), dtype=torch.int64, device=dev)
 
-    def gap(b_idx: torch.Tensor, r_idx: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
-        """z − η at distance t along rays (b_idx, r_idx), evaluated as (B, P) padded per image."""
+    def gap(b_idx: torch.Tensor, r_idx: torch.Tensor, t: torch.Tensor, partial: bool = False) -> torch.Tensor:
+        """z − η at distance t along rays (b_idx, r_idx), evaluated as (B, P) padded per image; with
+        ``partial``, (P, K) z − η_{≤j} (the last column z − η)."""
         pos = C[b_idx] + t[:, None] * D[b_idx, r_idx]
         x, y = _padded(b_idx, pos[:, 0], B), _padded(b_idx, pos[:, 1], B)
+        if partial and levels:
+            return pos[:, 2:3] - surface.partial_elevations(x[0], y[0]).transpose(1, 2)[x[1]]
         eta = surface(x[0], y[0])[0]
-        return pos[:, 2] - eta[x[1]]
+        g = pos[:, 2] - eta[x[1]]
+        return g[:, None] if partial else g
 
     # the march, on the rays still active (compacted every iteration)
     b_idx, r_idx = act.nonzero(as_tuple=True)
@@ -389,15 +418,18 @@ def march_first_hits(
             break
         if it == max_steps:
             raise RuntimeError(f"march_first_hits: {b_idx.numel()} rays still marching after max_steps = {max_steps}")
-        g = gap(b_idx, r_idx, t)
+        g = gap(b_idx, r_idx, t, partial=True)  # (P, K)
         steps[b_idx, r_idx] += 1
-        crossed = (g <= 0) | (t >= t_bot[b_idx, r_idx])  # at the slab's bottom the gap is ≤ 0 (but for rounding)
+        crossed = (g[:, -1] <= 0) | (t >= t_bot[b_idx, r_idx])  # at the slab's bottom the gap is ≤ 0 (but for rounding)
         if bool(crossed.any()):
             brackets.append((b_idx[crossed], r_idx[crossed], t_lo[crossed], t[crossed]))
         keep = ~crossed
         b_idx, r_idx, t, g = b_idx[keep], r_idx[keep], t[keep], g[keep]
         t_lo = t
-        step = torch.clamp(g / rate[b_idx, r_idx], min=hmin)
+        # z − η_{≤j} less the rest's amplitude is below the true gap and falls no faster than
+        # |d_z| + L_{≤j} |d_h| per metre: every level j gives a safe step; take the longest
+        rate = -safe_dz[b_idx, r_idx, None] + lip_j[b_idx] * horizontal[b_idx, r_idx, None]
+        step = ((g - slack[b_idx]) / rate).amax(1).clamp_min(hmin)
         t = torch.minimum(t + step, t_bot[b_idx, r_idx])
     if brackets:
         b_idx, r_idx, lo, hi = (torch.cat(parts) for parts in zip(*brackets))
