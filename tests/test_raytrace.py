@@ -14,7 +14,9 @@ Plants tried once each (the code edited, the tests run and seen to fail, the edi
 - the Lipschitz bound halved (``TracedSurface._bounds``):
   ``test_traced_surface_is_the_fields_bands_and_bounds_hold`` fails (finite-difference gradients
   above it). ``test_bounds_hold`` does not catch that one: the sum of the bands' largest gradients is
-  2–4× the surface's largest, which is what it also checks (the bound is not wild).
+  2–4× the surface's largest, which is what it also checks (the bound is not wild);
+- the partial-sum steps without the other bands' amplitude as slack: ``test_partial_sum_steps_find_the_same_hits``
+  fails (rays step over their first crossing, hits up to 135 m further).
 """
 
 from __future__ import annotations
