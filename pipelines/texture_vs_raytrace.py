@@ -27,7 +27,8 @@ All renders use a flat sea (``earth_radius_m=inf``), as the ray tracer does (at 
 turns the vertical by 0.007°).
 
 Usage:
-    python pipelines/texture_vs_raytrace.py [--quick | --full] [--out docs]
+    python pipelines/texture_vs_raytrace.py [--quick | --full] [--out docs] [--save results.pkl]
+    python pipelines/texture_vs_raytrace.py --replot results.pkl   # report and figures again, no tracing
 
 Defaults (about 30 min on 2 busy cores): 64 rays per pixel for the 12 cases, an ensemble of 8 seeds
 at 4 rays per pixel, the specular check at 64 rays per pixel on the two 10 m/s upwind cases.
@@ -40,6 +41,7 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import math
+import pickle
 import sys
 import time
 import warnings
@@ -317,11 +319,11 @@ def criteria(cases: list[dict], ens: list[dict]) -> list[str]:
     ]
 
 
-def report(args, cases, ens, spec, ident, timings, command) -> str:
+def report(args, cases, ens, spec, ident, timings, command, date) -> str:
     lines = [
         "# Textured renders against a brute-force ray tracer of the same realization",
         "",
-        f"Made by `{command}` on {dt.datetime.now().astimezone().strftime('%Y-%m-%d %H:%M %Z')} "
+        f"Made by `{command}` on {date} "
         f"(torch {torch.__version__}, {torch.get_num_threads()} threads).",
         "",
         "Scene: `rs.SeaScene(wind_speed=W, wind_direction=..., sea_temperature=290, seed=11, time_s=3.0, foam=False, "
@@ -401,12 +403,13 @@ def report(args, cases, ens, spec, ident, timings, command) -> str:
               "![textured, ray-traced and their difference, upwind](texture_vs_raytrace_upwind.png)", "",
               "![textured, ray-traced and their difference, crosswind](texture_vs_raytrace_crosswind.png)", "",
               "![σ against view zenith](texture_vs_raytrace_sigma.png)", "",
+              "![ensemble means against the expectation image](texture_vs_raytrace_mean.png)", "",
               "## Run time", "", "| step | seconds |", "|---|---:|"]
     lines += [f"| {k} | {v:.0f} |" for k, v in timings]
     return "\n".join(lines) + "\n"
 
 
-def figures(out: Path, cases: list[dict]) -> None:
+def figures(out: Path, cases: list[dict], ens: list[dict]) -> None:
     plt = pyplot()
     if plt is None:
         return
@@ -445,16 +448,42 @@ def figures(out: Path, cases: list[dict]) -> None:
             vz = [0.5 * (b["vz"][0] + b["vz"][1]) for b in c["bins"]]
             col = colours.get(c["wind"], "k")
             lab = f"{c['wind']:g} m/s" if c["pitch"] == PITCHES[0] else None
-            ax.plot(vz, [b["sigma_ray"] for b in c["bins"]], "-o", color=col, ms=3, label=f"ray-traced {lab}" if lab else None)
+            ok = [b["measurable"] for b in c["bins"]]
+            ray = [b["sigma_ray"] if m else math.nan for b, m in zip(c["bins"], ok)]
+            ax.plot(vz, ray, "-o", color=col, ms=3, label=f"ray-traced {lab}" if lab else None)
+            lim = [(v, b["sigma_ray_limit"]) for v, b, m in zip(vz, c["bins"], ok) if not m]
+            if lim:  # upper limits where the ray tracer's clutter does not stand out of its noise
+                ax.plot(*zip(*lim), "v", color=col, ms=5, mfc="none")
             ax.plot(vz, [b["sigma_tex"] for b in c["bins"]], "--s", color=col, ms=3, label=f"textured {lab}" if lab else None)
         ax.set_yscale("log")
         ax.set_xlabel("view zenith [°] (bin centre)")
         ax.set_title(f"{direction}, {DIRECTIONS[direction][0]:g} m mast")
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("clutter σ about the row mean [K]")
-    axes[0].legend(fontsize=7)
+    axes[0].legend(fontsize=7, title="open ▽: ray-traced below its noise", title_fontsize=7)
     fig.tight_layout()
     fig.savefig(out / "texture_vs_raytrace_sigma.png", dpi=110)
+    plt.close(fig)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
+    for ax, direction in zip(axes, DIRECTIONS):
+        for e in ens:
+            if e["direction"] != direction:
+                continue
+            vz = [0.5 * (b["vz"][0] + b["vz"][1]) for b in e["bins"]]
+            col = colours.get(e["wind"], "k")
+            lab = f"{e['wind']:g} m/s" if e["pitch"] == PITCHES[0] else None
+            ax.errorbar(vz, [b["ray"] for b in e["bins"]], [b["ray_se"] for b in e["bins"]], fmt="-o", color=col,
+                        ms=3, capsize=2, label=f"ray-traced {lab}" if lab else None)
+            ax.errorbar(vz, [b["tex"] for b in e["bins"]], [b["tex_se"] for b in e["bins"]], fmt="--s", color=col,
+                        ms=3, capsize=2, label=f"textured {lab}" if lab else None)
+        ax.axhline(0.0, color="k", lw=0.5)
+        ax.set_xlabel("view zenith [°] (bin centre)")
+        ax.set_title(f"{direction}, {DIRECTIONS[direction][0]:g} m mast")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("ensemble mean − expectation image [K]")
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out / "texture_vs_raytrace_mean.png", dpi=110)
     plt.close(fig)
 
 
@@ -464,8 +493,17 @@ def main() -> None:
     mode.add_argument("--quick", action="store_true", help="16 rays per pixel, 2 seeds, winds 5 and 15 m/s")
     mode.add_argument("--full", action="store_true", help="16-seed ensemble at 8 rays per pixel, specular check on all upwind cases")
     ap.add_argument("--out", default=str(ROOT / "docs"), help="directory of the report and figures")
-    ap.add_argument("--save", default=None, help="also save the case images (textured, ray-traced, expectation) to this .npz")
+    ap.add_argument("--save", default=None, help="also save every result (images included) to this pickle")
+    ap.add_argument("--replot", default=None, help="write the report and figures from a pickle of --save (no tracing)")
     args = ap.parse_args()
+    if args.replot:
+        with open(args.replot, "rb") as fh:
+            saved = pickle.load(fh)
+        figures(Path(args.out), saved["cases"], saved["ens"])
+        write_report(args.out, "texture_vs_raytrace.md", report(saved["args"], saved["cases"], saved["ens"], saved["spec"],
+                                                               saved["ident"], saved["timings"], saved["command"],
+                                                               saved["date"]))
+        return
     winds = (5.0, 15.0) if args.quick else (5.0, 10.0, 15.0)
     args.rays = 16 if args.quick else 64
     args.seeds = list(range(100, 102 if args.quick else (116 if args.full else 108)))
@@ -500,11 +538,13 @@ def main() -> None:
     ident = renderer_identities()
     timings.append(("renderer identities (far field, second law)", time.perf_counter() - t0))
     timings.append(("total", sum(v for _, v in timings)))
-    figures(out, cases)
-    write_report(out, "texture_vs_raytrace.md", report(args, cases, ens, spec, ident, timings, command))
+    date = dt.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z")
     if args.save:
-        np.savez_compressed(args.save, **{f"{c['direction']}_{c['wind']:g}_{-c['pitch']:g}_{k}": c[k]
-                                          for c in cases for k in ("tex", "ray", "exp")})
+        with open(args.save, "wb") as fh:
+            pickle.dump(dict(args=args, cases=cases, ens=ens, spec=spec, ident=ident, timings=timings, command=command,
+                             date=date), fh)
+    figures(out, cases, ens)
+    write_report(out, "texture_vs_raytrace.md", report(args, cases, ens, spec, ident, timings, command, date))
 
 
 if __name__ == "__main__":
