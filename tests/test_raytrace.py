@@ -200,7 +200,9 @@ def test_rays_into_the_sea_never_see_the_sky():
 def test_no_traced_waves_is_the_expectation_image():
     """With k_max below the field's lowest band nothing is traced: every ray sees the expectation at its
     flat-sea view angles, so the image is the renderer's expectation image (per-pixel evaluation,
-    same quadrature, flat sea), across a yawed camera and an oblique wind (azimuth conventions)."""
+    same quadrature, flat sea), across a yawed camera and an oblique wind. This also holds the tracer's
+    own scene (R_B, band-averaged water index, LOWTRAN sky, anisotropic Cox–Munk, azimuth conventions)
+    to the renderer's."""
     q = rs.Quadrature.default(torch.float64)
     cams = rs.make_camera(5, 6, hfov_deg=3e-4, altitude_m=15.0, pitch_deg=-5.0, yaw_deg=30.0, dtype=torch.float64)
     out = rt.raytraced_image(cams, 8.0, seed=2, wind_direction=1.1, rays_per_pixel=2, k_max=1e-3, quadrature=q)
@@ -208,18 +210,6 @@ def test_no_traced_waves_is_the_expectation_image():
     ref = rs.render(cams, scene, method="direct", quadrature=q, earth_radius_m=math.inf)
     assert torch.allclose(out["radiance"], ref, rtol=2e-6, atol=0)
     assert float(out["parallax_m"].abs().max()) < 1e-6
-
-
-def test_same_scene_as_the_renderer():
-    """The tracer's R_B, water index and wave field are the scene's (``SeaScene.resolved``, ``wave_field``)."""
-    scene = rs.SeaScene(wind_speed=10.0, sea_temperature=T_SEA, seed=11, time_s=3.0, foam=False, path=False)
-    res = scene.resolved(1, torch.float64, torch.device("cpu"))
-    m = rs.band_refractive_index(rs.LWIR, T_SEA)
-    assert float(res["n"]) == pytest.approx(m.real.item(), rel=1e-6)
-    assert float(res["k"]) == pytest.approx(m.imag.item(), rel=1e-6)
-    assert float(res["rb"]) == pytest.approx(float(rs.band_radiance(torch.tensor(T_SEA, dtype=torch.float64))), rel=1e-12)
-    cm = rs.SlopeStatistics.cox_munk(10.0, anisotropic=True)
-    assert (float(res["vx"]), float(res["vy"])) == pytest.approx((cm.var_upwind, cm.var_crosswind), rel=1e-12)
 
 
 def test_sampling_variance_estimates_the_noise():
