@@ -30,10 +30,11 @@ Usage:
     python pipelines/texture_vs_raytrace.py [--quick | --full] [--out docs] [--save results.pkl]
     python pipelines/texture_vs_raytrace.py --replot results.pkl   # report and figures again, no tracing
 
-Defaults (about 30 min on 2 busy cores): 64 rays per pixel for the 12 cases, an ensemble of 8 seeds
-at 4 rays per pixel, the specular check at 64 rays per pixel on the two 10 m/s upwind cases.
-``--full``: an ensemble of 16 seeds at 8 rays per pixel and the specular check on all six upwind
-cases (about 2.5× longer). ``--quick``: 16 rays per pixel, 2 seeds, winds 5 and 15 m/s only.
+Defaults: 64 rays per pixel for the 12 cases, an ensemble of 16 seeds at 4 rays per pixel, the specular
+check at 64 rays per pixel on the two 10 m/s upwind cases: 7 min on 2 idle cores, 21 min when four other
+jobs share them (the report gives the load average). ``--full``: 128 rays per pixel, 32 seeds at 8 rays
+per pixel, the specular check on all six upwind cases (about 4× longer). ``--quick``: 16 rays per pixel,
+2 seeds, winds 5 and 15 m/s only.
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import math
+import os
 import pickle
 import sys
 import time
@@ -397,7 +399,9 @@ def report(args, cases, ens, spec, ident, timings, command, date) -> str:
         "# Textured renders against a brute-force ray tracer of the same realization",
         "",
         f"Made by `{command}` on {date} "
-        f"(torch {torch.__version__}, {torch.get_num_threads()} threads).",
+        f"(torch {torch.__version__}, {torch.get_num_threads()} threads; load average {args.load[0]:.1f} at the start, "
+        f"{args.load[1]:.1f} at the end: the machine's {os.cpu_count()} cores were shared, so the run times below "
+        "vary with the other jobs).",
         "",
         "Scene: `rs.SeaScene(wind_speed=W, wind_direction=..., sea_temperature=290, seed=11, time_s=3.0, foam=False, "
         "path=False)`, LWIR 8–12 µm, LOWTRAN7 midlatitude-summer sky, anisotropic Cox–Munk; cameras 48×64 px over 12°, "
@@ -582,7 +586,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     mode = ap.add_mutually_exclusive_group()
     mode.add_argument("--quick", action="store_true", help="16 rays per pixel, 2 seeds, winds 5 and 15 m/s")
-    mode.add_argument("--full", action="store_true", help="16-seed ensemble at 8 rays per pixel, specular check on all upwind cases")
+    mode.add_argument("--full", action="store_true",
+                      help="128 rays per pixel, 32 seeds at 8 rays per pixel, specular check on all upwind cases")
     ap.add_argument("--out", default=str(ROOT / "docs"), help="directory of the report and figures")
     ap.add_argument("--save", default=None, help="also save every result (images included) to this pickle")
     ap.add_argument("--replot", default=None, help="write the report and figures from a pickle of --save (no tracing)")
@@ -596,13 +601,14 @@ def main() -> None:
                                                                saved["date"]))
         return
     winds = (5.0, 15.0) if args.quick else (5.0, 10.0, 15.0)
-    args.rays = 16 if args.quick else 64
-    args.seeds = list(range(100, 102 if args.quick else (116 if args.full else 108)))
-    args.ensemble_rays = 4 if not args.full else 8
+    args.rays = 16 if args.quick else 128 if args.full else 64
+    args.seeds = list(range(100, 102 if args.quick else (132 if args.full else 116)))
+    args.ensemble_rays = 8 if args.full else 4
     args.spec_rays = 16 if args.quick else 64
     spec_cases = [(w, p) for w in (winds if args.full else (15.0,) if args.quick else (10.0,)) for p in PITCHES]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    load_start = os.getloadavg()[0]
     command = "python pipelines/texture_vs_raytrace.py" + (" --quick" if args.quick else " --full" if args.full else "")
 
     combos = [(d, w, p) for d in DIRECTIONS for w in winds for p in PITCHES]
@@ -631,6 +637,7 @@ def main() -> None:
     timings.append(("renderer identities (far field, second law)", time.perf_counter() - t0))
     timings.append(("total", sum(v for _, v in timings)))
     date = dt.datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z")
+    args.load = (load_start, os.getloadavg()[0])
     if args.save:
         with open(args.save, "wb") as fh:
             pickle.dump(dict(args=args, cases=cases, ens=ens, spec=spec, ident=ident, timings=timings, command=command,
