@@ -115,8 +115,8 @@ def test_traced_surface_is_the_fields_bands_and_bounds_hold():
     bounds hold: |η| ≤ η_max at random points and the finite-difference gradient ≤ L."""
     field = _field(15.0, direction=0.7)
     gen = torch.Generator().manual_seed(1)
-    x = (torch.rand(1, 20000, generator=gen, dtype=torch.float64) - 0.5) * 3000
-    y = (torch.rand(1, 20000, generator=gen, dtype=torch.float64) - 0.5) * 3000
+    x = (torch.rand(1, 4000, generator=gen, dtype=torch.float64) - 0.5) * 3000
+    y = (torch.rand(1, 4000, generator=gen, dtype=torch.float64) - 0.5) * 3000
     for k_max, n_bands in ((64.0, 14), (1.0, 8), (math.inf, 16)):
         surf = rt.TracedSurface(field, 3.0, k_max)
         assert surf.n_traced == n_bands
