@@ -32,11 +32,10 @@ Usage:
 
 Defaults: 64 rays per pixel for the 12 cases, an ensemble of 16 seeds at 4 rays per pixel, the specular
 check at 64 rays per pixel on the two 10 m/s upwind cases, one torch thread (``--threads``); the report
-gives the run time and the machine's load average. On 2 cores shared with four other jobs (load average
-5–9) the same run took 39 min with 2 threads; one thread is 3–5× faster there.
-``--full``: 128 rays per pixel, 32 seeds at 8 rays
-per pixel, the specular check on all six upwind cases (about 4× longer). ``--quick``: 16 rays per pixel,
-2 seeds, winds 5 and 15 m/s only.
+gives the run time and the machine's load average: 10 min on 2 cores shared with four other jobs (load
+average 7.5–8.3), where the same run with 2 threads took 39 min. ``--full``: 128 rays per
+pixel, 32 seeds at 8 rays per pixel, the specular check on all six upwind cases (about 4× longer).
+``--quick``: 16 rays per pixel, 2 seeds, winds 5 and 15 m/s only.
 """
 
 from __future__ import annotations
@@ -437,7 +436,7 @@ def report(args, cases, ens, spec, ident, timings, command, date) -> str:
         "# Textured renders against a brute-force ray tracer of the same realization",
         "",
         f"Made by `{command}` on {date} "
-        f"(torch {torch.__version__}, {torch.get_num_threads()} threads; load average {args.load[0]:.1f} at the start, "
+        f"(torch {torch.__version__}, {args.threads} torch thread(s); load average {args.load[0]:.1f} at the start, "
         f"{args.load[1]:.1f} at the end: the machine's {os.cpu_count()} cores were shared, so the run times below "
         "vary with the other jobs).",
         "",
