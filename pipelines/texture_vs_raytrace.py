@@ -76,10 +76,56 @@ def scene(wind: float, direction: float, seed, *, sky="midlatitude_summer") -> r
                        foam=False, path=False, sky=sky)
 
 
+TABLE = rs.TableSize()  # the renderer's settings; --texture-hit chooses where pixels meet the resolved waves
+
+
 def render(cams, sc) -> torch.Tensor:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # the README's "resolved slopes scaled down" note
-        return rs.render(cams, sc, output="brightness_temperature", earth_radius_m=INF).double()
+        return rs.render(cams, sc, output="brightness_temperature", earth_radius_m=INF, table=TABLE).double()
+
+
+def retexture(saved: dict) -> tuple[list[dict], list[dict]]:
+    """The saved cases and ensembles with their textured side rendered again by this checkout's renderer
+    (``TABLE``) and its statistics recomputed; the ray tracer's side as it was saved (no tracing)."""
+    cases = []
+    for c in saved["cases"]:
+        mast, direction = DIRECTIONS[c["direction"]]
+        cams = rs.make_camera(H, W, hfov_deg=HFOV, altitude_m=mast, pitch_deg=c["pitch"])
+        tex = render(cams, scene(c["wind"], direction, SEED))[0, 0].numpy()
+        _, _, hidden = pixel_geometry(cams, c["wind"], direction)
+        bins = []
+        for b in c["bins"]:
+            sl = slice(b["rows"][0], b["rows"][0] + BIN)
+            a, r, nz, hid = tex[sl], c["ray"][sl], c["noise"][sl], hidden[sl]
+            m = b["measurable"]
+            bins.append(dict(b, sigma_tex=sigma(a), ratio=sigma(a) / b["sigma_ray"] if m else math.nan,
+                             r_pix=correlation(a, r, nz) if m else math.nan,
+                             r_block=block_correlation(a, r, nz) if m else math.nan, len_tex=correlation_length(a),
+                             mean_diff=float((a - r).mean()),
+                             hidden_warm=float((a - r)[hid].mean()) if hid.any() else math.nan))
+        cases.append(dict(c, tex=tex, bins=bins,
+                          hidden_warm=float((tex - c["ray"])[hidden].mean()) if hidden.any() else math.nan))
+    seeds = saved["args"].seeds
+    ens = []
+    for e in saved["ens"]:
+        mast, direction = DIRECTIONS[e["direction"]]
+        cams1 = rs.make_camera(H, W, hfov_deg=HFOV, altitude_m=mast, pitch_deg=e["pitch"])
+        camsn = rs.make_camera(H, W, hfov_deg=HFOV, altitude_m=mast, pitch_deg=e["pitch"], batch_size=len(seeds))
+        expct = render(cams1, scene(e["wind"], direction, None))
+        tex = render(camsn, scene(e["wind"], direction, seeds))
+        bins = []
+        for b in e["bins"]:
+            sl = slice(b["rows"][0], b["rows"][0] + BIN)
+            dt_ = (tex[:, 0, sl].mean(dim=(1, 2)) - expct[0, 0, sl].mean()).numpy()
+            tex_se = float(dt_.std(ddof=1) / math.sqrt(len(seeds)))
+            var_t = float(np.mean([signal_variance(tex[i, 0, sl].numpy())[0] for i in range(len(seeds))]))
+            measurable = not math.isnan(b["ratio"])
+            bins.append(dict(b, tex=float(dt_.mean()), tex_se=tex_se, diff=float(dt_.mean()) - b["ray"],
+                             diff_se=math.hypot(tex_se, b["ray_se"]), sigma_tex=math.sqrt(var_t),
+                             ratio=math.sqrt(var_t) / b["sigma_ray"] if measurable and b["sigma_ray"] > 0 else math.nan))
+        ens.append(dict(e, bins=bins))
+    return cases, ens
 
 
 # ---------------------------------------------------------------------------------------------
@@ -432,6 +478,8 @@ def reading(cases: list[dict], ens: list[dict], spec: list[dict]) -> list[str]:
 
 
 def report(args, cases, ens, spec, ident, timings, command, date) -> str:
+    hit = getattr(args, "texture_hit", "flat")
+    sfx = "" if hit == rs.TableSize().texture_hit else f"_{hit}"
     lines = [
         "# Textured renders against a brute-force ray tracer of the same realization",
         "",
@@ -443,7 +491,8 @@ def report(args, cases, ens, spec, ident, timings, command, date) -> str:
         "Scene: `rs.SeaScene(wind_speed=W, wind_direction=..., sea_temperature=290, seed=11, time_s=3.0, foam=False, "
         "path=False)`, LWIR 8–12 µm, LOWTRAN7 midlatitude-summer sky, anisotropic Cox–Munk; cameras 48×64 px over 12°, "
         "yaw 0, looking upwind (wind direction 0, 15 m mast) or crosswind (wind direction π/2, 20 m mast), pitch −6° "
-        "and −16°; flat sea in both renderers. Textured: `rs.render(..., output='brightness_temperature')`. "
+        "and −16°; flat sea in both renderers. Textured: `rs.render(..., output='brightness_temperature', "
+        f"table=rs.TableSize(texture_hit={hit!r}))` ({'the flat-sea point' if hit == 'flat' else 'the sweep along ground tracks'}). "
         f"Ray-traced: `roughsea_torch.raytrace.raytraced_image`, {args.rays} rays per pixel through i.i.d. points of "
         "the pixel, first hits on the field's bands with k ≤ 64 rad/m (Lipschitz march, bisection to 1e-7 m), the "
         "remaining slope covariance (Cox–Munk minus the traced bands') averaged by the model about the traced slope.",
@@ -528,16 +577,16 @@ def report(args, cases, ens, spec, ident, timings, command, date) -> str:
                          f"{s_spec} | {r['sigma_ref']:.3f} | {ratio} | "
                          f"{r['mean_diff']:+.3f} | {fmt(r['r_pix'])} | {fmt(r['r_block'])} |")
     lines += ["", "## Figures", "",
-              "![textured, ray-traced and their difference, upwind](texture_vs_raytrace_upwind.png)", "",
-              "![textured, ray-traced and their difference, crosswind](texture_vs_raytrace_crosswind.png)", "",
-              "![σ against view zenith](texture_vs_raytrace_sigma.png)", "",
-              "![ensemble means against the expectation image](texture_vs_raytrace_mean.png)", "",
+              f"![textured, ray-traced and their difference, upwind](texture_vs_raytrace_upwind{sfx}.png)", "",
+              f"![textured, ray-traced and their difference, crosswind](texture_vs_raytrace_crosswind{sfx}.png)", "",
+              f"![σ against view zenith](texture_vs_raytrace_sigma{sfx}.png)", "",
+              f"![ensemble means against the expectation image](texture_vs_raytrace_mean{sfx}.png)", "",
               "## Run time", "", "| step | seconds |", "|---|---:|"]
     lines += [f"| {k} | {v:.0f} |" for k, v in timings]
     return "\n".join(lines) + "\n"
 
 
-def figures(out: Path, cases: list[dict], ens: list[dict]) -> None:
+def figures(out: Path, cases: list[dict], ens: list[dict], suffix: str = "") -> None:
     plt = pyplot()
     if plt is None:
         return
@@ -565,7 +614,7 @@ def figures(out: Path, cases: list[dict], ens: list[dict]) -> None:
         fig.suptitle(f"Looking {direction} from {mast:g} m: the same realization (seed {SEED}, t = {TIME_S:g} s), "
                      "brightness temperature", fontsize=10)
         fig.tight_layout()
-        fig.savefig(out / f"texture_vs_raytrace_{direction}.png", dpi=110)
+        fig.savefig(out / f"texture_vs_raytrace_{direction}{suffix}.png", dpi=110)
         plt.close(fig)
     def sigma_panel(ax, direction):
         for c in cases:
@@ -591,9 +640,9 @@ def figures(out: Path, cases: list[dict], ens: list[dict]) -> None:
                             ms=3, capsize=2, label=f"{name} {lab}" if lab else None)
         ax.axhline(0.0, color="k", lw=0.5)
 
-    _by_direction(plt, out / "texture_vs_raytrace_sigma.png", "clutter σ about the row mean [K]", sigma_panel,
+    _by_direction(plt, out / f"texture_vs_raytrace_sigma{suffix}.png", "clutter σ about the row mean [K]", sigma_panel,
                   "open ▽: ray-traced below its noise")
-    _by_direction(plt, out / "texture_vs_raytrace_mean.png", "ensemble mean − expectation image [K]", mean_panel)
+    _by_direction(plt, out / f"texture_vs_raytrace_mean{suffix}.png", "ensemble mean − expectation image [K]", mean_panel)
 
 
 COLOURS = {5.0: "tab:blue", 10.0: "tab:orange", 15.0: "tab:red"}
@@ -634,16 +683,32 @@ def main() -> None:
                     help="torch threads (default 1: on cores shared with other jobs, 2 threads ran 3-5x slower than 1)")
     ap.add_argument("--save", default=None, help="also save every result (images included) to this pickle")
     ap.add_argument("--replot", default=None, help="write the report and figures from a pickle of --save (no tracing)")
+    ap.add_argument("--retexture", default=None,
+                    help="a pickle of --save: render its textured side again with this checkout (no tracing)")
+    ap.add_argument("--texture-hit", choices=("flat", "first"), default=rs.TableSize().texture_hit,
+                    help="TableSize.texture_hit of the textured renders (default: the renderer's)")
     args = ap.parse_args()
     torch.set_num_threads(max(1, args.threads))
-    if args.replot:
-        with open(args.replot, "rb") as fh:
+    global TABLE
+    TABLE = rs.TableSize(texture_hit=args.texture_hit)
+    suffix = "" if args.texture_hit == rs.TableSize().texture_hit else f"_{args.texture_hit}"
+    if args.replot or args.retexture:
+        with open(args.replot or args.retexture, "rb") as fh:
             saved = pickle.load(fh)
-        figures(Path(args.out), saved["cases"], saved["ens"])
-        write_report(args.out, "texture_vs_raytrace.md", report(saved["args"], saved["cases"], saved["ens"], saved["spec"],
-                                                               saved["ident"], saved["timings"], saved["command"],
-                                                               saved["date"]))
+        cases, ens = (saved["cases"], saved["ens"]) if args.replot else retexture(saved)
+        Path(args.out).mkdir(parents=True, exist_ok=True)
+        command = saved["command"] + (f" --texture-hit {args.texture_hit}" if suffix else "")
+        if args.retexture:
+            command += f"  (textured side again: --retexture, {dt.date.today().isoformat()})"
+        saved["args"].texture_hit = args.texture_hit
+        if not hasattr(saved["args"], "threads"):  # a pickle of an earlier version
+            saved["args"].threads = torch.get_num_threads()
+        figures(Path(args.out), cases, ens, suffix)
+        write_report(args.out, f"texture_vs_raytrace{suffix}.md", report(saved["args"], cases, ens, saved["spec"],
+                                                                        saved["ident"], saved["timings"], command,
+                                                                        saved["date"]))
         return
+    args.texture_hit = args.texture_hit
     winds = (5.0, 15.0) if args.quick else (5.0, 10.0, 15.0)
     args.rays = 16 if args.quick else 128 if args.full else 64
     args.seeds = list(range(100, 102 if args.quick else (132 if args.full else 116)))
@@ -653,7 +718,8 @@ def main() -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     load_start = os.getloadavg()[0]
-    command = "python pipelines/texture_vs_raytrace.py" + (" --quick" if args.quick else " --full" if args.full else "")
+    command = ("python pipelines/texture_vs_raytrace.py" + (" --quick" if args.quick else " --full" if args.full else "")
+               + (f" --texture-hit {args.texture_hit}" if suffix else ""))
 
     combos = [(d, w, p) for d in DIRECTIONS for w in winds for p in PITCHES]
     total = H * len(combos) * (1 + len(args.seeds)) + H * len(spec_cases)
@@ -686,8 +752,8 @@ def main() -> None:
         with open(args.save, "wb") as fh:
             pickle.dump(dict(args=args, cases=cases, ens=ens, spec=spec, ident=ident, timings=timings, command=command,
                              date=date), fh)
-    figures(out, cases, ens)
-    write_report(out, "texture_vs_raytrace.md", report(args, cases, ens, spec, ident, timings, command, date))
+    figures(out, cases, ens, suffix)
+    write_report(out, f"texture_vs_raytrace{suffix}.md", report(args, cases, ens, spec, ident, timings, command, date))
 
 
 if __name__ == "__main__":
