@@ -369,21 +369,8 @@ def raytraced_image(
         'facing_away_fraction' share of hits whose traced slope faces away; 'far_fraction',
         'sky_fraction'; 'steps' mean march steps; and 'n_rays' (int) S.
     """
-    if mode not in ("two_scale", "specular"):
-        raise ValueError(f"mode must be 'two_scale' or 'specular'; got {mode!r}")
-    S = check_count("rays_per_pixel", rays_per_pixel, 2)
-    if not isinstance(cameras, PinholeCamera):
-        raise ValueError(f"cameras must be a kornia PinholeCamera; got {type(cameras).__name__}")
-    check_positive("sea_temperature", sea_temperature, "K")
-    if not isinstance(wind_speed, (int, float)) or isinstance(wind_speed, bool):
-        raise ValueError(f"wind_speed must be a float [m/s]; got {type(wind_speed).__name__}")
-    if not isinstance(wind_direction, (int, float)) or isinstance(wind_direction, bool) or not math.isfinite(wind_direction):
-        raise ValueError(f"wind_direction must be a finite float [rad]; got {wind_direction!r}")
-    check_positive("k_max", k_max, "rad/m", allow_inf=True)
-    check_positive("tolerance_m", tolerance_m, "m")
-    check_positive("min_step_m", min_step_m, "m")
-    check_positive("max_range_m", max_range_m, "m", allow_inf=True)
-    check_count("ray_seed", ray_seed, 0)
+    S = _check_arguments(cameras, wind_speed, wind_direction, sea_temperature, rays_per_pixel, k_max, mode, ray_seed,
+                         tolerance_m, min_step_m, max_range_m)
     out_dtype, dev = cameras.intrinsics.dtype, cameras.device()
     B = cameras.batch_size
     H, W = int(cameras.height[0].item()), int(cameras.width[0].item())
@@ -457,8 +444,34 @@ def raytraced_image(
             acc[k][:, rows] = part[k]
         if progress is not None:
             progress(rows.stop - rows.start)
+    return _finish(acc, S, band, rb, out_dtype)
+
+
+def _check_arguments(cameras: Any, wind_speed: Any, wind_direction: Any, sea_temperature: Any, rays_per_pixel: Any,
+                     k_max: Any, mode: Any, ray_seed: Any, tolerance_m: Any, min_step_m: Any, max_range_m: Any) -> int:
+    """:func:`raytraced_image`'s argument checks (``ValueError`` naming the argument); the rays per pixel."""
+    if mode not in ("two_scale", "specular"):
+        raise ValueError(f"mode must be 'two_scale' or 'specular'; got {mode!r}")
+    S = check_count("rays_per_pixel", rays_per_pixel, 2)
+    if not isinstance(cameras, PinholeCamera):
+        raise ValueError(f"cameras must be a kornia PinholeCamera; got {type(cameras).__name__}")
+    check_positive("sea_temperature", sea_temperature, "K")
+    if not isinstance(wind_speed, (int, float)) or isinstance(wind_speed, bool):
+        raise ValueError(f"wind_speed must be a float [m/s]; got {type(wind_speed).__name__}")
+    if not isinstance(wind_direction, (int, float)) or isinstance(wind_direction, bool) or not math.isfinite(wind_direction):
+        raise ValueError(f"wind_direction must be a finite float [rad]; got {wind_direction!r}")
+    check_positive("k_max", k_max, "rad/m", allow_inf=True)
+    check_positive("tolerance_m", tolerance_m, "m")
+    check_positive("min_step_m", min_step_m, "m")
+    check_positive("max_range_m", max_range_m, "m", allow_inf=True)
+    check_count("ray_seed", ray_seed, 0)
+    return S
+
+
+def _finish(acc: dict, S: int, band: Any, rb: torch.Tensor, out_dtype: torch.dtype) -> dict:
+    """The accumulated per-pixel sums as :func:`raytraced_image` returns them: brightness temperature
+    of the mean and its sampling variance [K²] (the radiance's over dB/dT² at the pixel's temperature)."""
     bt = brightness_temperature(acc["radiance"], band)
-    # dB/dT at the pixel's temperature: the sampling variance of the mean radiance in K²
     t_req = bt.detach().clone().requires_grad_(True)
     (slope,) = torch.autograd.grad(band_radiance(t_req, band).sum(), t_req)
     acc["brightness_temperature"] = bt

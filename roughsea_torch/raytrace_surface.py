@@ -15,7 +15,7 @@ Conventions: world frame right-handed, z up, sea level z = 0, metres.
 from __future__ import annotations
 
 import math
-from typing import Any, Protocol
+from typing import Any, Callable, Protocol
 
 import numpy as np
 import torch
@@ -231,6 +231,23 @@ def _padded(b_idx: torch.Tensor, values: torch.Tensor, B: int) -> tuple[torch.Te
     return grid, (b_idx, slot)
 
 
+def _bisect(gap: Callable[[torch.Tensor], torch.Tensor], lo: torch.Tensor, hi: torch.Tensor, tol: float) -> torch.Tensor:
+    """The crossing of rays bracketed by ``lo`` (gap > 0) and ``hi`` (gap ≤ 0) along them, bisected until
+    the brackets are shorter than ``tol`` (or the dtype's resolution is reached): their midpoints."""
+    while True:  # keep lo above the surface and hi on or below it
+        open_ = (hi - lo) > tol
+        if not bool(open_.any()):
+            break
+        mid = 0.5 * (lo + hi)
+        below = gap(mid) <= 0
+        stuck = (mid <= lo) | (mid >= hi)  # the dtype's resolution reached
+        hi = torch.where(open_ & below & ~stuck, mid, hi)
+        lo = torch.where(open_ & ~below & ~stuck, mid, lo)
+        if bool(stuck[open_].all()):
+            break
+    return 0.5 * (lo + hi)
+
+
 def march_first_hits(
     centres: torch.Tensor,
     directions: torch.Tensor,
@@ -324,18 +341,7 @@ def march_first_hits(
         t = torch.minimum(t + step, t_bot[b_idx, r_idx])
     if brackets:
         b_idx, r_idx, lo, hi = (torch.cat(parts) for parts in zip(*brackets))
-        while True:  # bisection: keep lo above the surface and hi on or below it
-            open_ = (hi - lo) > tol
-            if not bool(open_.any()):
-                break
-            mid = 0.5 * (lo + hi)
-            below = gap(b_idx, r_idx, mid) <= 0
-            stuck = (mid <= lo) | (mid >= hi)  # the dtype's resolution reached
-            hi = torch.where(open_ & below & ~stuck, mid, hi)
-            lo = torch.where(open_ & ~below & ~stuck, mid, lo)
-            if bool(stuck[open_].all()):
-                break
-        out_t[b_idx, r_idx] = 0.5 * (lo + hi)
+        out_t[b_idx, r_idx] = _bisect(lambda t_: gap(b_idx, r_idx, t_), lo, hi, tol)
     hit = torch.isfinite(out_t)
     tt = torch.where(hit, out_t, torch.zeros_like(out_t))
     pos = C[:, None, :] + tt[..., None] * D
