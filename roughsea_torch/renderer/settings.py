@@ -82,7 +82,7 @@ class TableSize:
             ``"flat"`` (default): at its flat-sea point, the resolved slope's quantile mapped onto the
             visible-slope distribution (:func:`~roughsea_torch.clutter.visible_slope`; its ensemble
             mean is the expectation image exactly, but near grazing it has neither parallax nor
-            hiding).
+            hiding). The table method's setting; ``method="direct"`` evaluates the flat point per pixel.
         texture_hit_step, texture_hit_min_step, texture_hit_across, texture_hit_tracks: the sweep of
             ``texture_hit="first"``: its samples' spacing in depression [pixels], ``across`` · cos θ̂/2
             clamped into [``min_step``, ``step``] (each sample filtered at twice its spacing's footprint
