@@ -7,8 +7,10 @@ MWIR, E_sun = 12 W m⁻²) seen
 - by the brute force (:func:`roughsea_torch.raytrace_glitter.glitter_spots`: every band a mirror
   facet, the spots found by Newton's method from ray hits, each weighted by its image area), as the
   grid-integrated spot areas ('truth, box') and the linearized ones ('truth, linear');
-- by the textured render (``rs.render``: the glint of the scene with the sun minus the scene without);
-- by the textured render times the glitter factor (:mod:`roughsea_torch.glitter`), N per pixel from
+- by the textured render (``rs.render``: the glint of the scene with the sun minus the scene without),
+  with the flat-point and the first-hit texture (``TableSize.texture_hit``), each also with the renderer's
+  glitter (``TableSize(glitter=True)``, one draw at t = 0);
+- by the first-hit render times the glitter factor (:mod:`roughsea_torch.glitter`), N per pixel from
   the footprint, the slope density at the specular slope (the expectation's, scaled by the pixel's
   glint over the expectation's glint) and E|det H|; 32 glitter draws, their statistics averaged;
 - by the expectation with the total law (Cox–Munk) and with the field's own slope variance.
@@ -53,9 +55,16 @@ def run(seed: int, rays: int) -> dict[str, tuple[float, float, float]]:
     cm = G.curvature_moments(torch.tensor(WIND, dtype=torch.float64))
     tr = glitter_spots(cam, field, SUN_ZENITH, 0.0, E_SUN, m_idx, rays_per_pixel=rays, third_derivative=float(cm.third))
     out = {"truth, box": stats(tr["glint"]), "truth, linear": stats(tr["linearized_glint"])}
-    rnd = (rs.render(cam, scene(seed, True)) - rs.render(cam, scene(seed, False)))[0, 0].double()
     exp = (rs.render(cam, scene(None, True)) - rs.render(cam, scene(None, False)))[0, 0].double()
-    out["render (textured)"] = stats(rnd)
+    renders = {}
+    for hit in ("flat", "first"):
+        tab, tab_g = rs.TableSize(texture_hit=hit), rs.TableSize(texture_hit=hit, glitter=True)
+        base = rs.render(cam, scene(seed, False), table=tab)
+        renders[hit] = (rs.render(cam, scene(seed, True), table=tab) - base)[0, 0].double()
+        out[f"render, {hit} hit"] = stats(renders[hit])
+        out[f"render, {hit} hit, glitter (the renderer's, t = 0)"] = stats(
+            (rs.render(cam, scene(seed, True), table=tab_g) - base)[0, 0].double())
+    rnd = renders["first"]
     out["expectation (Cox–Munk)"] = stats(exp)
     # N per pixel: footprint × p(s_g) × E|det H|, p(s_g) the expectation's (total law) scaled by the pixel's glint
     H = W = N_PIX
@@ -79,7 +88,7 @@ def run(seed: int, rays: int) -> dict[str, tuple[float, float, float]]:
     for g_seed in range(32):
         zl = G.glitter_latent(g_seed, torch.arange(H * W), 0.0).reshape(H, W)
         draws.append(stats(rnd * G.glitter_factor(n_pix, zl, spread)))
-    out["render + glitter (32 draws)"] = tuple(sum(x[i] for x in draws) / len(draws) for i in range(3))
+    out["render, first hit, glitter (32 draws)"] = tuple(sum(x[i] for x in draws) / len(draws) for i in range(3))
     # the expectation with the field's own total slope variance (what the brute force's surface has)
     fc = field.resolved_covariance(torch.zeros(1, dtype=torch.float64))
     sf = rs.SlopeStatistics.from_variances(float(fc[0]), float(fc[1]), float(fc[2]))
@@ -87,8 +96,14 @@ def run(seed: int, rays: int) -> dict[str, tuple[float, float, float]]:
     g_field = rs.glint_radiance(torch.acos(ct), ph, sf, m_idx, rs.Sun(SUN_ZENITH, 0.0, E_SUN))
     g_cm = rs.glint_radiance(torch.acos(ct), ph, sl, m_idx, rs.Sun(SUN_ZENITH, 0.0, E_SUN))
     out["expectation (field's slopes)"] = stats(g_field.reshape(H, W) * (exp / g_cm.reshape(H, W)).mean())
+    cnt = tr["spots_per_pixel"]
+    loc = torch.nn.functional.avg_pool2d(cnt[None, None], 3, 1, 1, count_include_pad=False)[0, 0]
+    ok = loc > 0.5
+    fano = float((((cnt - loc) ** 2 / loc)[ok]).mean()) * 9 / 8  # 9/8: the pixel is part of its own 3 × 3 mean
+    print(f"seed {seed}: spot counts' variance over their mean: {float(cnt.var() / cnt.mean()):.2f} about the patch "
+          f"mean, {fano:.2f} about the 3 × 3 local mean (Poisson: 1)")
     print(f"seed {seed}: {tr['spots']} spots ({tr['spots'] / (H * W):.1f} per pixel), N model {float(n_exp.mean()):.1f} per "
-          f"pixel, 1 + κ = {float(spread):.2f}, starts per spot {tr['starts_per_spot']:.1f}, spots touching their box "
+          f"pixel, F(1 + κ) = {float(spread):.2f}, starts per spot {tr['starts_per_spot']:.1f}, spots touching their box "
           f"{tr['edge_share']:.0%} of the glint, hidden {tr['hidden']}", flush=True)
     return out
 
@@ -100,11 +115,16 @@ def main() -> None:
     args = ap.parse_args()
     torch.set_num_threads(1)
     print("| seed | image | patch mean [W m⁻² sr⁻¹] | spread/mean | p99/mean |\n|---|---|---|---|---|")
-    rows = []
+    rows, per = [], {}
     for seed in args.seeds:
         for name, (m, s, p) in run(seed, args.rays).items():
             rows.append(f"| {seed} | {name} | {m:.2f} | {s:.2f} | {p:.2f} |")
+            per.setdefault(name, []).append((m, s, p))
     print("\n".join(rows))
+    print(f"\nmedian over seeds {args.seeds}:\n\n| image | patch mean | spread/mean | p99/mean |\n|---|---|---|---|")
+    for name, v in per.items():
+        med = torch.tensor(v).median(0).values.tolist()
+        print(f"| {name} | {med[0]:.2f} | {med[1]:.2f} | {med[2]:.2f} |")
 
 
 if __name__ == "__main__":

@@ -53,10 +53,18 @@ of η along a direction), so the spot reaches at most r ≈ √(2a/T) for the el
 space, and the weight saturates as if |λ₂| ≥ λ_c = √(aT/2). :func:`glitter_spread` evaluates κ with
 w = 1/(|λ₁| max(|λ₂|, λ_c)) over a fixed quasi-random sample of Hessians (deterministic).
 
+Clustering. The spots are not a Poisson process: specular points are born and die in pairs (where
+det H changes sign), and the unresolved waves longer than the curvature scale gather them. On the
+brute force (``docs/glitter.md``) the spot counts per pixel scatter about their local (3 × 3 pixel)
+mean with a variance 2.1–3.5 times the mean (median 3.0 over eight realizations), where a Poisson
+count would give 1. The model takes this as a measured factor F = :data:`GLITTER_CLUSTERING` = 3 on
+the variance: Var / mean² = F (1 + κ) / N. It is measured on the spot counts, not fitted to the
+glint's quantiles (which then check it), and not derived here.
+
 The draw (:func:`glitter_factor`)
 ---------------------------------
-A log-normal factor g = exp(σ z − σ²/2) with σ² = ln(1 + (1 + κ)/N) and z ~ N(0, 1): E g = 1 exactly
-and Var g = (1 + κ)/N, the compound Poisson's first two moments (a gamma law has them too; the
+A log-normal factor g = exp(σ z − σ²/2) with σ² = ln(1 + F(1 + κ)/N) and z ~ N(0, 1): E g = 1 exactly
+and Var g = F(1 + κ)/N, the clustered compound Poisson's first two moments (a gamma law has them too; the
 log-normal's mean is exact in closed form for any σ, which the renderer's mean-preservation rests
 on, and a Gaussian z makes it coherent in time, below). For N ≫ 1 + κ it tends to 1.
 
@@ -81,12 +89,13 @@ from ._validation import as_tensor, check_finite_range, resolve_dtype_device
 from .quadrature import gauss_nodes
 from .spectrum import check_wave_age, check_wind_speed, dispersion, elfouhaily_omnidirectional, elfouhaily_spreading
 
-__all__ = ["GLITTER_K_MAX", "GLITTER_LIFETIME_S", "CurvatureMoments", "curvature_moments",
+__all__ = ["GLITTER_K_MAX", "GLITTER_LIFETIME_S", "GLITTER_CLUSTERING", "CurvatureMoments", "curvature_moments",
            "mean_abs_hessian_determinant", "specular_slope_density", "glitter_count", "glitter_spread",
-           "glitter_factor", "glitter_latent"]
+           "glitter_factor", "glitter_factor_unchecked", "glitter_latent"]
 
 GLITTER_K_MAX = 256.0  # [rad m⁻¹] the curvature's top wavenumber: the default wave field's shortest band edge
 GLITTER_LIFETIME_S = 0.175  # [s] hotspot lifetime, the middle of Schwering's (1991) 0.15–0.20 s
+GLITTER_CLUSTERING = 3.0  # the spots' overdispersion over Poisson, measured on the brute force (docs/glitter.md)
 _DECADES = 14.0  # e-folds of wavenumber below k_max in the moments' integral (k⁴ S is negligible below)
 _N_K = 192  # Gauss–Legendre nodes in ln k
 _N_PSI = 64  # uniform nodes of the periodic ψ average of E|det H|
@@ -204,11 +213,13 @@ def glitter_count(slope_density: Any, footprint_area: Any, mean_abs_det: Any) ->
         mean_abs_det, dtype, device)
 
 
-def glitter_spread(moments: CurvatureMoments, ellipse_radius: Any) -> torch.Tensor:
-    """1 + κ = E_spot[w²] / E_spot[w]² of the spots' weights (module docstring), from the Hessian's
-    moments and the sun ellipse's radius a in slope space (√(α² |det J|), > 0). Over a fixed
-    scrambled-Sobol sample of 4096 Hessians (seed 0: deterministic); shape of the moments."""
+def glitter_spread(moments: CurvatureMoments, ellipse_radius: Any, clustering: float = GLITTER_CLUSTERING) -> torch.Tensor:
+    """F (1 + κ): 1 + κ = E_spot[w²] / E_spot[w]² of the spots' weights (module docstring), from the
+    Hessian's moments and the sun ellipse's radius a in slope space (√(α² |det J|), > 0), times the
+    clustering factor F ≥ 1 (1: Poisson spots). Over a fixed scrambled-Sobol sample of 4096 Hessians
+    (seed 0: deterministic); shape of the moments."""
     check_finite_range("ellipse_radius", ellipse_radius, 0.0, 1.0, lo_open=True)
+    check_finite_range("clustering", clustering, 1.0, 100.0)
     uu, cc, uc, third = moments.uu, moments.cc, moments.uc, moments.third
     dtype, device = uu.dtype, uu.device
     sob = torch.quasirandom.SobolEngine(3, scramble=True, seed=0).draw(_N_HESS, dtype=torch.float64)
@@ -225,7 +236,7 @@ def glitter_spread(moments: CurvatureMoments, ellipse_radius: Any) -> torch.Tens
     lam_c = torch.sqrt(as_tensor(ellipse_radius, dtype, device) * third / 2.0)[..., None]
     det = big * small
     w = 1.0 / (big * torch.maximum(small, lam_c))
-    return det.mean(-1) * (det * w * w).mean(-1) / (det * w).mean(-1) ** 2
+    return clustering * det.mean(-1) * (det * w * w).mean(-1) / (det * w).mean(-1) ** 2
 
 
 def _hash(x: torch.Tensor) -> torch.Tensor:
@@ -276,13 +287,18 @@ def glitter_factor(count: Any, latent: Any, spread: Any = 1.0) -> torch.Tensor:
     """The glitter factor g = exp(σ z − σ²/2), σ² = ln(1 + spread / N), of pixels with N = ``count``
     expected spots (≥ 0; N = 0 is taken as 1e-6: a pixel that almost never glints flashes rarely and
     brightly), latent ``latent`` z (standard normal: :func:`glitter_latent`, or any N(0, 1) draws) and
-    ``spread`` = 1 + κ ≥ 1 (:func:`glitter_spread`): E g = 1 and Var g = spread / N exactly when z is
+    ``spread`` = F (1 + κ) ≥ 1 (:func:`glitter_spread`): E g = 1 and Var g = spread / N exactly when z is
     N(0, 1). Broadcast shape; dtype/device follow ``count``; differentiable in N."""
     check_finite_range("count", count, 0.0)
     check_finite_range("latent", latent, -40.0, 40.0)
     check_finite_range("spread", spread, 1.0)
     dtype, device = resolve_dtype_device(count=count, spread=spread)
-    n = as_tensor(count, dtype, device).clamp_min(1e-6)
-    z = as_tensor(latent, dtype, device)
-    var = torch.log1p(as_tensor(spread, dtype, device) / n)
-    return torch.exp(torch.sqrt(var) * z - 0.5 * var)
+    return glitter_factor_unchecked(as_tensor(count, dtype, device), as_tensor(latent, dtype, device),
+                                    as_tensor(spread, dtype, device))
+
+
+def glitter_factor_unchecked(count: torch.Tensor, latent: torch.Tensor, spread: torch.Tensor) -> torch.Tensor:
+    """:func:`glitter_factor` without its checks, for the renderer's own (checked) pixels: tensors of
+    one dtype and device that broadcast."""
+    var = torch.log1p(spread / count.clamp_min(1e-6))
+    return torch.exp(torch.sqrt(var) * latent - 0.5 * var)
