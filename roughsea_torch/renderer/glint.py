@@ -103,7 +103,7 @@ def glint_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: torch.Te
     (``resolved[0]`` may be the pair (x, x'), x' the visible quantile read from the texture volume).
     ``tau_rows`` = (τ at the fine table's sea rows (b, M_z), each pixel's fractional row (b, H, W))
     with a path, else None. ``glitter`` (textured seas only): :func:`glitter_inputs`' (footprint area,
-    E|det H|, F (1 + κ), latent z); each pixel's glint is then multiplied by its glitter factor, N = area ·
+    E|det H|, F (1 + κ), and the latent's pixel numbers, seeds, times and step); each pixel's glint is then multiplied by its glitter factor, N = area ·
     p(s_g) · E|det H| with p the pixel's own unresolved Gaussian (:mod:`roughsea_torch.glitter`)."""
     b_, H, W = cos_t.shape
     dtype, device = cos_t.dtype, cos_t.device
@@ -134,10 +134,11 @@ def glint_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: torch.Te
             (vx, vy, cxy), (mx, my) = shifted.tensors(dtype, device), shifted.mean_tensors(dtype, device)
         g = glint_from_moments(torch.acos(c_k.clamp(-1.0, 1.0)), phi, vx, vy, cxy, mx, my, n_, k_, tz, tp, e_sun, al, scene.shadowing)
         if glitter is not None and mx is not None:
-            area, edet, spread, latent = glitter
+            area, edet, spread, pixel, seeds, times, tau = glitter
             p_sg, _ = specular_slope_density(c_k, torch.sqrt((1.0 - c_k * c_k).clamp_min(0.0)), torch.cos(phi), torch.sin(phi),
                                              vx, vy, cxy, mx, my, tz, tp)
-            g = g * glitter_factor_unchecked(at(area) * p_sg * edet[m], at(latent), spread[m])
+            z = glitter_latent(seeds[m], at(pixel), float(times[m]), tau).to(dtype)  # at the kept pixels only
+            g = g * glitter_factor_unchecked(at(area) * p_sg * edet[m], z, spread[m])
         if g1 is not None:
             g = g * g1[m]
         if tau_rows is not None:  # the path's transmittance: quadratic through the table's 3 nearest rows
@@ -160,9 +161,11 @@ def glitter_inputs(field: Any, cos_t: torch.Tensor, altitude: torch.Tensor, ifov
     each pixel's horizontal footprint area (R δ)² / cos θ̂ [m²] (b, H, W) (R the slant range at the
     camera ``altitude`` (b,), δ = ``ifov`` (b,), cos θ̂ = ``cos_t``); E|det H| (b,) and F (1 + κ) (b,) from
     the curvature of the image's wave ``field`` (its wind and wave age, up to its top band edge), κ
-    at the sun ellipse's radius α/(2 √cos θ_sun) of the sun's own mirror direction; and the latent
-    z (b, H, W) of every pixel at the image's time ``time_s`` (b,) for ``lifetime_s``, seeded by the
-    field's seed (so a clip's frames of one realization share their glitter's history)."""
+    at the sun ellipse's radius α/(2 √cos θ_sun) of the sun's own mirror direction; and what the
+    latent z of a pixel needs (:func:`~roughsea_torch.glitter.glitter_latent`, evaluated at the
+    pixels that can see glint): the pixels' flat numbers (b, H, W) int64, the field's seeds (so a
+    clip's frames of one realization share their glitter's history), the images' times ``time_s``
+    (b,) and ``lifetime_s``."""
     b_, H, W = cos_t.shape
     dtype, device = cos_t.dtype, cos_t.device
     R = slant_range(cos_t, altitude.to(dtype)[:, None, None], earth_radius_m)
@@ -171,9 +174,8 @@ def glitter_inputs(field: Any, cos_t: torch.Tensor, altitude: torch.Tensor, ifov
     edet = mean_abs_hessian_determinant(mom.uu, mom.cc, mom.uc).to(dtype)
     radius = sun_radius.detach().to(torch.float64) * 0.5 * torch.rsqrt(torch.cos(sun_zenith.detach().to(torch.float64)).clamp_min(1e-3))
     spread = glitter_spread(mom, radius.clamp(1e-9, 1.0)).to(dtype)
-    idx = torch.arange(H * W, device=device)
-    latent = torch.stack([glitter_latent(int(field.seeds[i]), idx, float(time_s[i]), lifetime_s) for i in range(b_)])
-    return area, edet, spread, latent.reshape(b_, H, W).to(dtype)
+    pixel = torch.arange(H * W, device=device).reshape(1, H, W).expand(b_, H, W)
+    return area, edet, spread, pixel, tuple(int(v) for v in field.seeds), time_s.detach().cpu(), lifetime_s
 
 
 def glint_table(scene: SeaScene, p: SceneParameters, sl: slice, eps: torch.Tensor, lo: torch.Tensor,

@@ -98,8 +98,9 @@ class TableSize:
             mean 1 whose variance F (1 + κ)/N follows the expected number N of glitter spots in the
             pixel's footprint, coherent in time (the sea's seed and time set it). Textured sunny scenes
             of the table method only (``method="direct"`` and scenes without ``seed`` ignore it).
-        glitter_lifetime_s: the glitter's lifetime τ [s] in (0, 100] (default 0.175 s, Schwering's
-            measured 0.15–0.2 s hotspots): a pixel's factor decorrelates over about τ.
+        glitter_lifetime_s: the glitter's time step τ [s] in (0, 100] (default 0.25 s): a pixel's
+            factor decorrelates over about τ, its hotspots last 0.68 τ (0.17 s: Schwering's measured
+            0.15–0.2 s).
 
     For accuracy finer than the defaults, e.g. MWIR day skies about the sun:
     ``TableSize(texture_quadrature=(20, 16), texture_azimuth_sun=17, fine_texture_azimuth=64)``.
@@ -137,7 +138,7 @@ class TableSize:
     glint: int = 33
     glint_tolerance: float = 1e-5
     glitter: bool = False
-    glitter_lifetime_s: float = 0.175
+    glitter_lifetime_s: float = 0.25
 
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):

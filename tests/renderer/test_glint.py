@@ -97,7 +97,7 @@ def _glitter_pair(times, table_kw=None, dtype=torch.float64, seed=4):
 
 def test_glitter_keeps_the_glint_mean_and_sparkles():
     """TableSize(glitter=True) multiplies each textured pixel's glint by a factor of mean 1: over the
-    pixels of independent frames (1 s apart, beyond the 0.175 s lifetime) the glint-weighted mean
+    pixels of independent frames (1 s apart, beyond two of the default 0.25 s steps) the glint-weighted mean
     ratio is 1 within four standard errors (measured ~1e-2 here: the exact mean is tested on the
     factor itself, tests/test_glitter.py), while the spread across pixels grows and the 99th
     percentile rises well above the smooth path's (near range: a few spots per pixel)."""
