@@ -158,6 +158,19 @@ def _spot_areas(surf: TracedSurface, c: torch.Tensor, w: torch.Tensor, xs: torch
     return ins.to(xs.dtype).mean((-1, -2)) * box, edge, lin_area
 
 
+def _image_jacobian(cams: PinholeCamera, p: torch.Tensor, sx: torch.Tensor, sy: torch.Tensor, h: float = 1e-4) -> torch.Tensor:
+    """|det ∂(u, v)/∂(x, y)| [px² m⁻²] of surface points p (P, 3) with slopes s: the pixel coordinates of
+    (x, y, η(x, y)) by central differences of step h along the surface (dη = −s · dx)."""
+    n = p.shape[0]
+    steps = ((1, 0), (-1, 0), (0, 1), (0, -1))
+    pts = torch.stack([p + torch.stack([torch.full((n,), a * h, dtype=p.dtype, device=p.device),
+                                        torch.full((n,), b * h, dtype=p.dtype, device=p.device),
+                                        -(a * h) * sx - (b * h) * sy], -1) for a, b in steps])  # (4, P, 3)
+    uv = cams.project(pts.reshape(1, -1, 3)).reshape(4, -1, 2)
+    du, dv = (uv[0] - uv[1]) / (2 * h), (uv[2] - uv[3]) / (2 * h)
+    return (du[:, 0] * dv[:, 1] - du[:, 1] * dv[:, 0]).abs()
+
+
 def glitter_spots(cameras: PinholeCamera, field: WaveField, sun_zenith: float, sun_azimuth: float, sun_irradiance: float,
                   refractive_index: Any, *, time_s: float = 0.0, sun_radius: float = math.radians(0.2666),
                   rays_per_pixel: int = 64, ray_seed: int = 0, iterations: int = 30, fd_step_m: float = 2e-4,
@@ -218,13 +231,7 @@ def glitter_spots(cameras: PinholeCamera, field: WaveField, sun_zenith: float, s
     sgx, sgy = q[:, 0] / q[:, 2], q[:, 1] / q[:, 2]
     area_h, edge, lin_area = _spot_areas(surf, c, w, xs, ys, sgx, sgy, q[:, 2], sun_radius, fd_step_m, third_derivative,
                                          grid)
-    h = 1e-4
-    pts = torch.stack([p + torch.stack([torch.full_like(xs, s0 * h), torch.full_like(xs, s1 * h),
-                                        -(s0 * h) * sx - (s1 * h) * sy], -1)
-                       for s0, s1 in ((1, 0), (-1, 0), (0, 1), (0, -1))])  # (4, P, 3): along the surface
-    uv = cams.project(pts.reshape(1, -1, 3)).reshape(4, -1, 2)
-    du, dv = (uv[0] - uv[1]) / (2 * h), (uv[2] - uv[3]) / (2 * h)
-    jac_img = (du[:, 0] * dv[:, 1] - du[:, 1] * dv[:, 0]).abs()
+    jac_img = _image_jacobian(cams, p, sx, sy)
     n_hat = torch.stack([sx, sy, torch.ones_like(sx)], -1)
     cos_inc = (n_hat * v).sum(-1) / n_hat.norm(dim=-1)
     rho = fresnel_reflectance(cos_inc.clamp(0.0, 1.0), refractive_index)
