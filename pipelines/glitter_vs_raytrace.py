@@ -2,7 +2,7 @@
 
 For each seed: a 24 × 24 pixel patch (0.82 mrad pixels, a 640-pixel camera with a 30° field of
 view; 10 m above the sea, looking 10° down, the sun 15° above the horizon straight ahead, 8 m/s,
-MWIR, E_sun = 12 W m⁻²) seen
+MWIR, E_sun = 12 W m⁻²; wind, pitch and sun elevation are options) seen
 
 - by the brute force (:func:`roughsea_torch.raytrace_glitter.glitter_spots`: every band a mirror
   facet, the spots found by Newton's method from ray hits, each weighted by its image area), as the
@@ -18,7 +18,8 @@ MWIR, E_sun = 12 W m⁻²) seen
 Prints a markdown table: patch mean, spread/mean (std across pixels over the mean), p99/mean.
 
 Usage:
-    PYTHONPATH=. python pipelines/glitter_vs_raytrace.py [--seeds 1 2] [--rays 256]
+    PYTHONPATH=. python pipelines/glitter_vs_raytrace.py [--seeds 1 2] [--rays 256] [--wind 8] [--pitch -10]
+                                                         [--sun-elevation 15]
 """
 
 from __future__ import annotations
@@ -109,10 +110,16 @@ def run(seed: int, rays: int) -> dict[str, tuple[float, float, float]]:
 
 
 def main() -> None:
+    global WIND, PITCH, SUN_ZENITH
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--rays", type=int, default=256)
+    ap.add_argument("--wind", type=float, default=WIND)
+    ap.add_argument("--pitch", type=float, default=PITCH, help="camera pitch [deg] (negative: down)")
+    ap.add_argument("--sun-elevation", type=float, default=90.0 - math.degrees(SUN_ZENITH))
     args = ap.parse_args()
+    WIND, PITCH, SUN_ZENITH = args.wind, args.pitch, math.radians(90.0 - args.sun_elevation)
+    print(f"wind {WIND:g} m/s, pitch {PITCH:g}°, sun {90 - math.degrees(SUN_ZENITH):g}° up\n")
     torch.set_num_threads(1)
     print("| seed | image | patch mean [W m⁻² sr⁻¹] | spread/mean | p99/mean |\n|---|---|---|---|---|")
     rows, per = [], {}

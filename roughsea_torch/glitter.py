@@ -264,11 +264,11 @@ def _normal(key: torch.Tensor) -> torch.Tensor:
 
 def glitter_latent(seed: Any, index: torch.Tensor, time_s: Any = 0.0, lifetime_s: Any = GLITTER_LIFETIME_S) -> torch.Tensor:
     """The latent z(t) ~ N(0, 1) of pixels ``index`` (int64 tensor, e.g. flat pixel numbers) of one
-    image with seed ``seed`` (int in [0, 2**62)) at time ``time_s`` [s] (float or tensor broadcasting
+    image with seed ``seed`` (int in [0, 2**63)) at time ``time_s`` [s] (float or tensor broadcasting
     with ``index``, |t| ≤ 1e9) for a lifetime ``lifetime_s`` [s] > 0 (module docstring): float64,
     index's shape; the same arguments give the same values on every device."""
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 62:
-        raise ValueError(f"seed must be an int in [0, 2**62); got {seed!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 63:
+        raise ValueError(f"seed must be an int in [0, 2**63); got {seed!r}")
     check_finite_range("time_s", time_s, -1e9, 1e9, unit="s")
     check_finite_range("lifetime_s", lifetime_s, 0.0, 1e6, lo_open=True, unit="s")
     if not isinstance(index, torch.Tensor) or index.dtype != torch.int64 or (index.numel() and bool((index < 0).any())):

@@ -84,6 +84,8 @@ def test_glitter_latent_is_standard_normal_reproducible_and_coherent_in_time():
     assert abs(float((z > 2.0).double().mean()) - 0.02275) < 1e-3  # the normal's tail
     assert abs(float((z[1:] * z[:-1]).mean())) < 5e-3  # neighbouring pixels independent
     assert torch.equal(z, G.glitter_latent(11, idx, 4.2, 0.175))
+    extreme = G.glitter_latent(2 ** 63 - 1, idx, 1e9)  # the largest seed and time a scene accepts
+    assert abs(float(extreme.mean())) < 5e-3 and abs(float(extreme.std()) - 1.0) < 5e-3
     assert not torch.equal(z, G.glitter_latent(12, idx, 4.2, 0.175))
     near = G.glitter_latent(11, idx, 4.2 + 0.005, 0.175)
     far = G.glitter_latent(11, idx, 4.2 + 0.5, 0.175)  # beyond two lattice steps
