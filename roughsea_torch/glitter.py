@@ -55,20 +55,18 @@ w = 1/(|λ₁| max(|λ₂|, λ_c)) over a fixed quasi-random sample of Hessians 
 
 Clustering. The spots are not a Poisson process: specular points are born and die in pairs (where
 det H changes sign), and the unresolved waves longer than the curvature scale gather them. On the
-brute force (``docs/glitter.md``) the spot counts per pixel scatter about their local (3 × 3 pixel)
-mean with a variance F times the mean, where a Poisson count would give 1: F = 3.0 (median of eight
-realizations, range 2.1–3.5) for 0.82 mrad pixels at 57 m and 80° (8 m/s), F = 1.6 (four
-realizations, 1.4–2.0) at 39 m and 75° (12 m/s). The model takes the geometric mean of the two,
-F = :data:`GLITTER_CLUSTERING` = 2.2, on the variance: Var / mean² = F (1 + κ) / N. It is measured
-on the spot counts, not fitted to the glint's quantiles (which then check it); its dependence on
-the footprint and the wind is not modelled.
+brute force the spot counts per pixel scatter about their local mean with a variance F times the
+mean, where a Poisson count would give 1. The model takes a factor F = :data:`GLITTER_CLUSTERING`
+on the variance, Var / mean² = F (1 + κ) / N, measured on the brute force's spot counts at two
+geometries (``docs/glitter.md`` §1), not derived; its dependence on the footprint and the wind is
+not modelled.
 
 The draw (:func:`glitter_factor`)
 ---------------------------------
 A log-normal factor g = exp(σ z − σ²/2) with σ² = ln(1 + F(1 + κ)/N) and z ~ N(0, 1): E g = 1 exactly
 and Var g = F(1 + κ)/N, the clustered compound Poisson's first two moments (a gamma law has them too; the
 log-normal's mean is exact in closed form for any σ, which the renderer's mean-preservation rests
-on, and a Gaussian z makes it coherent in time, below). For N ≫ 1 + κ it tends to 1.
+on, and a Gaussian z makes it coherent in time, below). For N ≫ F (1 + κ) it tends to 1.
 
 Coherence in time: z(t) = cos(πu/2) z_j + sin(πu/2) z_{j+1}, u = frac(t/τ + φ), j = ⌊t/τ + φ⌋, with
 i.i.d. N(0, 1) lattice values z_j per pixel (a counter-based hash of the seed, the pixel and j) and a
@@ -79,7 +77,7 @@ the turnover of the specular points themselves is set by the curvature-weighted 
 :func:`curvature_moments`, 1/ω_c ≈ 21 ms for the default field's centimetre waves at 4–12 m/s, while
 MWIR sequences show hotspots lasting 0.15–0.20 s (Schwering 1991, Proc. SPIE 1486). The default
 τ = :data:`GLITTER_LIFETIME_S` = 0.25 s follows the measurement (hotspots of 0.17 s), not the
-derivation (``docs/glitter.md`` discusses the gap).
+derivation (``docs/glitter.md`` §1 discusses the gap, with the brute force's own turnover).
 """
 
 from __future__ import annotations
@@ -99,7 +97,7 @@ __all__ = ["GLITTER_K_MAX", "GLITTER_LIFETIME_S", "GLITTER_CLUSTERING", "Curvatu
 
 GLITTER_K_MAX = 256.0  # [rad m⁻¹] the curvature's top wavenumber: the default wave field's shortest band edge
 GLITTER_LIFETIME_S = 0.25  # [s] the latent's step τ: hotspots (z > 2) then last 0.17 s, Schwering's (1991) 0.15–0.20 s
-GLITTER_CLUSTERING = 2.2  # the spots' overdispersion over Poisson, measured on the brute force (docs/glitter.md)
+GLITTER_CLUSTERING = 2.2  # F: the spots' count variance over Poisson's (docs/glitter.md §1: 3.0 and 1.6 on two patches)
 _DECADES = 14.0  # e-folds of wavenumber below k_max in the moments' integral (k⁴ S is negligible below)
 _N_K = 192  # Gauss–Legendre nodes in ln k
 _N_PSI = 64  # uniform nodes of the periodic ψ average of E|det H|

@@ -30,10 +30,9 @@ Method
    central differences through the kornia camera). Its radiance is ρ(Ω) L_sun (Fresnel at the
    facet, L_sun = E_sun / Ω_sun), so it adds ρ L_sun × (image area in pixels²) to the mean radiance
    of the pixel it falls in. The linearized area, capped where |det ∂s/∂x| → 0 at the area the
-   third-order term allows (:mod:`roughsea_torch.glitter`), is returned alongside as a check: the
-   two agree on the patch mean and quantiles within a few per cent (``docs/glitter.md``), although
-   about half of the glint lies in spots that reach their box's edge (elongated spots, or two spots
-   of a pair close together).
+   third-order term allows (:mod:`roughsea_torch.glitter`), is returned alongside as a check
+   (``docs/glitter.md`` §2 compares the two), with the share of the glint in spots that reach their
+   box's edge (elongated spots, or two spots of a pair close together).
 
 Limits: spots on or very near a pixel edge go wholly to one pixel; a spot that is hidden only in
 part counts whole or not at all; spots not reached by any Newton start are missed (the returned
