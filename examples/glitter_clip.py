@@ -8,7 +8,7 @@ the same pixels, 0.82 mrad); frames 0.1 s apart. Top row: the glint as the expec
 pixel's unresolved facets; bottom row: the same frames with glitter. One colour range for the figure.
 
 Usage:
-    python examples/glitter_clip.py [--out docs] [--frames 4] [--dt 0.1]
+    python examples/glitter_clip.py [--out docs] [--frames 3] [--dt 0.1]
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from _common import save_grid
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "examples")
-    ap.add_argument("--frames", type=int, default=4)
+    ap.add_argument("--frames", type=int, default=3)
     ap.add_argument("--dt", type=float, default=0.1)
     args = ap.parse_args()
     torch.set_num_threads(1)
