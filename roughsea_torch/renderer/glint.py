@@ -7,7 +7,9 @@
   and columns (for images it serves, checked against direct evaluation), times the sharp factor
   P ρ t evaluated per pixel (:func:`glint_sharp_pixels`).
 - :func:`glint_pixels`: the whole glint per pixel, for the other images and for textured seas
-  (each pixel's own unresolved Gaussian about its resolved slope).
+  (each pixel's own unresolved Gaussian about its resolved slope); with ``TableSize.glitter`` the
+  textured pixel's glint times its glitter factor (:mod:`roughsea_torch.glitter`), whose inputs
+  :func:`glitter_inputs` makes.
 
 Radiance in W m⁻² sr⁻¹ in the scene's band; azimuths relative to upwind.
 """
@@ -20,6 +22,9 @@ from typing import Any, Callable
 import torch
 
 from ..clutter import along_view, two_scale_statistics
+from ..geometry import slant_range
+from ..glitter import (curvature_moments, glitter_factor_unchecked, glitter_latent, glitter_spread,
+                       mean_abs_hessian_determinant, specular_slope_density)
 from ..slopes import SlopeStatistics
 from ..sun import glint_from_moments, glint_sharp_factor, sun_masking_factor
 from .scene import SceneParameters, SeaScene
@@ -28,7 +33,8 @@ from .sky_terms import relative_sun
 from .spectral import barycentric, lobatto_interp
 from .texture import single_quantile
 
-__all__ = ["glint_mask", "glint_pixels", "glint_table", "glint_sharp_pixels", "over_kept_pixels", "upwind_los"]
+__all__ = ["glint_mask", "glint_pixels", "glint_table", "glint_sharp_pixels", "glitter_inputs", "over_kept_pixels",
+           "upwind_los"]
 
 
 def over_kept_pixels(keep: torch.Tensor, fn: Any, dtype: torch.dtype) -> torch.Tensor:
@@ -88,7 +94,7 @@ def glint_mask(p: SceneParameters, sl: slice, sun: Any, cos_t: torch.Tensor, dx:
 
 def glint_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: torch.Tensor, dx: torch.Tensor,
                   dy: torch.Tensor, sea: torch.Tensor, tau_rows: tuple[torch.Tensor, torch.Tensor] | None,
-                  resolved: tuple | None = None) -> torch.Tensor:
+                  resolved: tuple | None = None, glitter: tuple | None = None) -> torch.Tensor:
     """τ · R_glint at the sea pixels of images ``sl`` (b, H, W), 0 elsewhere, evaluated at the pixels that
     can see glint (:func:`glint_mask`). On a
     textured sea (``resolved`` = each pixel's flat-point quantile x and resolved covariance) the glint
@@ -96,7 +102,9 @@ def glint_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: torch.Te
     reflection is (:mod:`roughsea_torch.clutter`), so its ensemble mean is the expectation's glint
     (``resolved[0]`` may be the pair (x, x'), x' the visible quantile read from the texture volume).
     ``tau_rows`` = (τ at the fine table's sea rows (b, M_z), each pixel's fractional row (b, H, W))
-    with a path, else None."""
+    with a path, else None. ``glitter`` (textured seas only): :func:`glitter_inputs`' (footprint area,
+    E|det H|, F (1 + κ), and the latent's pixel numbers, seeds, times and step); each pixel's glint is then multiplied by its glitter factor, N = area ·
+    p(s_g) · E|det H| with p the pixel's own unresolved Gaussian (:mod:`roughsea_torch.glitter`)."""
     b_, H, W = cos_t.shape
     dtype, device = cos_t.dtype, cos_t.device
     B = p.vx.shape[0]
@@ -125,6 +133,12 @@ def glint_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: torch.Te
                                                          visible=None if x_vis is None else at(x_vis)[:, None]))
             (vx, vy, cxy), (mx, my) = shifted.tensors(dtype, device), shifted.mean_tensors(dtype, device)
         g = glint_from_moments(torch.acos(c_k.clamp(-1.0, 1.0)), phi, vx, vy, cxy, mx, my, n_, k_, tz, tp, e_sun, al, scene.shadowing)
+        if glitter is not None and mx is not None:
+            area, edet, spread, pixel, seeds, times, tau = glitter
+            p_sg, _ = specular_slope_density(c_k, torch.sqrt((1.0 - c_k * c_k).clamp_min(0.0)), torch.cos(phi), torch.sin(phi),
+                                             vx, vy, cxy, mx, my, tz, tp)
+            z = glitter_latent(seeds[m], at(pixel), float(times[m]), tau).to(dtype)  # at the kept pixels only
+            g = g * glitter_factor_unchecked(at(area) * p_sg * edet[m], z, spread[m])
         if g1 is not None:
             g = g * g1[m]
         if tau_rows is not None:  # the path's transmittance: quadratic through the table's 3 nearest rows
@@ -138,6 +152,30 @@ def glint_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: torch.Te
         return g
 
     return over_kept_pixels(keep, glint_of_pixels, dtype)
+
+
+def glitter_inputs(field: Any, cos_t: torch.Tensor, altitude: torch.Tensor, ifov: torch.Tensor, earth_radius_m: float,
+                   time_s: torch.Tensor, sun_zenith: torch.Tensor, sun_radius: torch.Tensor, lifetime_s: float
+                   ) -> tuple[torch.Tensor, ...]:
+    """The glitter's inputs for :func:`glint_pixels` of a chunk of b images (:mod:`roughsea_torch.glitter`):
+    each pixel's horizontal footprint area (R δ)² / cos θ̂ [m²] (b, H, W) (R the slant range at the
+    camera ``altitude`` (b,), δ = ``ifov`` (b,), cos θ̂ = ``cos_t``); E|det H| (b,) and F (1 + κ) (b,) from
+    the curvature of the image's wave ``field`` (its wind and wave age, up to its top band edge), κ
+    at the sun ellipse's radius α/(2 √cos θ_sun) of the sun's own mirror direction; and what the
+    latent z of a pixel needs (:func:`~roughsea_torch.glitter.glitter_latent`, evaluated at the
+    pixels that can see glint): the pixels' flat numbers (b, H, W) int64, the field's seeds (so a
+    clip's frames of one realization share their glitter's history), the images' times ``time_s``
+    (b,) and ``lifetime_s``."""
+    b_, H, W = cos_t.shape
+    dtype, device = cos_t.dtype, cos_t.device
+    R = slant_range(cos_t, altitude.to(dtype)[:, None, None], earth_radius_m)
+    area = (R * ifov.to(dtype)[:, None, None]) ** 2 / cos_t.clamp_min(1e-9)
+    mom = curvature_moments(field.wind_speed.detach(), field.inverse_wave_age.detach(), float(field.bands.k_edges[-1]))
+    edet = mean_abs_hessian_determinant(mom.uu, mom.cc, mom.uc).to(dtype)
+    radius = sun_radius.detach().to(torch.float64) * 0.5 * torch.rsqrt(torch.cos(sun_zenith.detach().to(torch.float64)).clamp_min(1e-3))
+    spread = glitter_spread(mom, radius.clamp(1e-9, 1.0)).to(dtype)
+    pixel = torch.arange(H * W, device=device).reshape(1, H, W).expand(b_, H, W)
+    return area, edet, spread, pixel, tuple(int(v) for v in field.seeds), time_s.detach().cpu(), lifetime_s
 
 
 def glint_table(scene: SeaScene, p: SceneParameters, sl: slice, eps: torch.Tensor, lo: torch.Tensor,

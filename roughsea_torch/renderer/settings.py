@@ -95,6 +95,18 @@ class TableSize:
             one-pixel horizontal lines; the ensemble mean is unchanged); False: unfiltered. Both
             methods; the sweep is not filtered.
 
+    The glint of textured seas (:mod:`roughsea_torch.glitter`, ``docs/glitter.md``):
+
+    Args:
+        glitter: ``False`` (default): each textured pixel's glint is the expectation over its
+            unresolved facets (a smooth "moon path"). ``True``: that glint times a random factor of
+            mean 1 whose variance F (1 + κ)/N follows the expected number N of glitter spots in the
+            pixel's footprint, coherent in time (the sea's seed and time set it). Textured sunny scenes
+            of the table method only (``method="direct"`` and scenes without ``seed`` ignore it).
+        glitter_lifetime_s: the glitter's time step τ [s] in (0, 100] (default 0.25 s): a pixel's
+            factor decorrelates over about τ, its hotspots last 0.68 τ (0.17 s: Schwering's measured
+            0.15–0.2 s).
+
     For accuracy finer than the defaults, e.g. MWIR day skies about the sun:
     ``TableSize(texture_quadrature=(20, 16), texture_azimuth_sun=17, fine_texture_azimuth=64)``.
     """
@@ -131,6 +143,8 @@ class TableSize:
     azimuth_day: int = 25
     glint: int = 33
     glint_tolerance: float = 1e-5
+    glitter: bool = False
+    glitter_lifetime_s: float = 0.25
 
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):
@@ -161,6 +175,12 @@ class TableSize:
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real) or not lo <= float(v) <= hi:
                 raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")
             object.__setattr__(self, name, float(v))
+        if not isinstance(self.glitter, (bool, np.bool_)):
+            raise ValueError(f"TableSize.glitter must be a bool; got {self.glitter!r}")
+        tau = self.glitter_lifetime_s
+        if isinstance(tau, (bool, np.bool_)) or not isinstance(tau, Real) or not 0.0 < float(tau) <= 100.0:
+            raise ValueError(f"TableSize.glitter_lifetime_s must be a number in (0, 100] s; got {tau!r}")
+        object.__setattr__(self, "glitter_lifetime_s", float(tau))
         share = self.texture_min_band_share
         if isinstance(share, bool) or not isinstance(share, (int, float)) or not 0.0 <= float(share) < 1.0:
             raise ValueError(f"TableSize.texture_min_band_share must be a number in [0, 1); got {share!r}")

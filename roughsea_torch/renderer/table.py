@@ -45,7 +45,7 @@ from ..slopes import SlopeStatistics
 from .coordinates import (ViewSpans, angle_of_ratio, asinh_fast, azimuth_coordinate, azimuth_ratio, camera_spans,
                           geometry_spans, ratio_of_angle)
 from .foam_terms import foam_radiance_of_images
-from .glint import glint_pixels, glint_sharp_pixels, glint_table
+from .glint import glint_pixels, glint_sharp_pixels, glint_table, glitter_inputs
 from .output import kelvin
 from .path import path_rows
 from .pixels import table_grid
@@ -557,7 +557,15 @@ def pixel_glint(plan: RenderPlan, ft: FineTable, rays: PixelRays, cos_t: torch.T
         rows = (ft.tau.to(dtype), (rays.zeta - (ft.lo - plan.ez * ft.span_z / 2).to(dtype)[:, None, None])
                 * ((plan.Mz - 1) / (ft.span_z * (1.0 + plan.ez))).to(dtype)[:, None, None])
     sea = rays.sea if ft.glint_tab is None else rays.sea & ~ft.glint_tab[:, None, None]
-    glint = glint_pixels(plan.scene, p, sl, cos_t, rays.dx, rays.dy, sea, rows, resolved)
+    glitter = None
+    if plan.table.glitter and resolved is not None and plan.texture is not None:  # TableSize.glitter
+        tex = plan.texture
+        sun = plan.scene.sun
+        zen = torch.as_tensor(sun.zenith, dtype=torch.float64).expand(plan.B)[sl]
+        rad = torch.as_tensor(sun.radius, dtype=torch.float64).expand(plan.B)[sl]
+        glitter = glitter_inputs(tex.field(sl), cos_t, tex.altitude[sl], tex.ifov[sl], tex.earth_radius_m, tex.time[sl],
+                                 zen, rad, plan.table.glitter_lifetime_s)
+    glint = glint_pixels(plan.scene, p, sl, cos_t, rays.dx, rays.dy, sea, rows, resolved, glitter)
     if p.foam is not None and not ft.crest:
         glint = glint * (1.0 - p.foam[sl].to(dtype))[:, None, None]
     return glint
