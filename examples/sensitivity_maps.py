@@ -36,7 +36,7 @@ def main() -> None:
     out = [bt.detach()] + [torch.where(sea, m, torch.tensor(math.nan)) for m in maps]
     save_grid(torch.cat(out), ["brightness temperature [K]", "dT_b / d wind [K per m/s]", "dT_b / dT_sea [K/K]",
                                "dT_b / d pitch [K per deg]"], args.out / "sensitivity_maps.png", label="", ncols=2,
-              cmap="coolwarm")
+              cmap="coolwarm", shared_scale=False, note="each panel has its own colour range: four different quantities")
     print(f"wrote {args.out}/sensitivity_maps.png")
 
 

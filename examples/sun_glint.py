@@ -23,7 +23,7 @@ from pathlib import Path
 import torch
 
 import roughsea_torch as rs
-from _common import plt, save_grid
+from _common import colour_range, plt, save_grid
 
 
 def main() -> None:
@@ -46,7 +46,12 @@ def main() -> None:
         scene = rs.SeaScene(wind_speed=6.0, sea_temperature=290.0, band=band, sun=sun)
         images.append(rs.render(cams, scene, output="brightness_temperature"))
         titles += [f"{name}, sun {e:g}° up ahead, E = {e_sun:g} W/m²" for e in elevations]
-    save_grid(torch.cat(images), titles, args.out / "sun_glint_scenes.png", label="brightness temperature [K]", ncols=3)
+    # one colour range per band (row), 0.5–99.5 % of its pixels: the sun's disk (a few pixels, thousands of
+    # kelvin in MWIR) clips to the bar's top instead of turning the sea and the glint black
+    rows = [colour_range(im) for im in images]
+    save_grid(torch.cat(images), titles, args.out / "sun_glint_scenes.png", label="brightness temperature [K]", ncols=3,
+              ranges=[r for r in rows for _ in elevations], note="each band (row) has its own colour range, 0.5–99.5 % "
+                                                                 "of its pixels (the sun's disk clips to the top)")
 
     th = torch.linspace(math.radians(50.0), math.radians(89.5), 300, dtype=torch.float64)
     sun = rs.Sun(math.radians(70.0), math.pi, args.mwir_irradiance)  # LOS azimuth 0 faces a sun at azimuth π

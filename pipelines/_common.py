@@ -28,7 +28,7 @@ from roughsea_torch.expectation import Quadrature
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 from conftest import smooth_sky as sky  # noqa: E402
-from test_agreement import M  # noqa: E402
+from conftest import M11 as M  # noqa: E402
 
 CONVERGED = Quadrature(outer=64, inner=64, hermite=32, width=9.5)
 SEA_RADIANCE = 30.0  # R_B [W m-2 sr-1] of the accuracy cases (the smooth sky reaches it at the horizon)

@@ -1,7 +1,7 @@
 """Accuracy of the core model at its default settings: torch against the numpy reference and
 against a converged torch rule, over the core issue's range.
 
-1. The agreement cases of ``tests/test_agreement.py`` (wind 0–40 m/s, σ² to 1e-6, θ̂ to 89.99°,
+1. The agreement cases of ``tests/test_expectation.py`` (wind 0–40 m/s, σ² to 1e-6, θ̂ to 89.99°,
    a/b = 10, |r| = 0.9, shadowing on/off): relative error of emissivity and apparent radiance of
    the default torch rule, float64 and float32, against the independent numpy reference.
 2. A dense sweep (12 view zenith angles × 5 azimuths × 19 slope laws × shadowing on/off) against
@@ -30,7 +30,8 @@ import roughsea_torch.reference as ref
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from _common import CONVERGED, sky  # noqa: E402
-from test_agreement import CASES, M, case_inputs, make_slopes  # noqa: E402
+from conftest import M11 as M  # noqa: E402
+from test_expectation import CASES, case_inputs, make_slopes  # noqa: E402
 
 
 def main() -> None:

@@ -151,6 +151,25 @@ def main() -> None:
         rows.append((threads, t_mean, t_tex))
         lines.append(f"| {threads} | {t_mean:.3f} | {t_tex:.3f} | {t_tex / t_mean:.2f} |")
         print(lines[-1], file=sys.stderr)
+    # where pixels meet the resolved waves: the sweep along ground tracks (TableSize(texture_hit="first"):
+    # crests hide what is behind them) against the flat-sea point (the default), timed alternately
+    first = rs.TableSize(texture_hit="first")
+    lines += ["", "Textured with the sweep (`TableSize(texture_hit=\"first\")`: a crest hides what is behind it, a "
+              "pixel averages what it sees) against the flat-sea point (the default), timed alternately:", "",
+              "| threads | flat point [s] | sweep [s] | sweep / flat point |", "|---:|---:|---:|---:|"]
+    for threads in (1, 2):
+        torch.set_num_threads(threads)
+        t_flat, t_first = [], []
+        for _ in range(args.repeats):
+            t0 = time.perf_counter()
+            rs.render(cams, tex_scene)
+            t_flat.append(time.perf_counter() - t0)
+            t0 = time.perf_counter()
+            rs.render(cams, tex_scene, table=first)
+            t_first.append(time.perf_counter() - t0)
+        t_flat, t_first = sorted(t_flat)[len(t_flat) // 2], sorted(t_first)[len(t_first) // 2]
+        lines.append(f"| {threads} | {t_flat:.3f} | {t_first:.3f} | {t_first / t_flat:.2f} |")
+        print(lines[-1], file=sys.stderr)
     # by day: the same batch with the sun 10° above the horizon straight ahead of each camera (its
     # glint per pixel where it can be seen), LOWTRAN7 irradiance, against the same batch by night
     cam, sc = batch(B)

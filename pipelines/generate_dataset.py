@@ -29,16 +29,37 @@ back with ``roughsea_torch.dataset.SeaShardDataset``.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 import time
 import tomllib
 from pathlib import Path
 
+import tomli_w
 import torch
 
 from roughsea_torch.dataset import DEFAULT_CONFIG, finish, generate, resolve_config
+
+
+def default_config_toml() -> str:
+    """``DEFAULT_CONFIG`` as a TOML file (what ``--config`` reads). TOML has no null: keys whose default
+    is "not set" (None) are left out (an omitted key takes its default) and listed in a comment."""
+    unset: list[str] = []
+
+    def drop_none(d: dict, prefix: str = "") -> dict:
+        out = {}
+        for k, v in d.items():
+            if v is None:
+                unset.append(prefix + k)
+            else:
+                out[k] = drop_none(v, f"{prefix}{k}.") if isinstance(v, dict) else v
+        return out
+
+    body = tomli_w.dumps(drop_none(DEFAULT_CONFIG))
+    head = "# roughsea_torch dataset config: every key with its default (python pipelines/generate_dataset.py --print-default-config)\n"
+    if unset:
+        head += "# not set by default (give a value to set them): " + ", ".join(unset) + "\n"
+    return head + "\n" + body
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -52,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--print-default-config", action="store_true")
     args = ap.parse_args(argv)
     if args.print_default_config:
-        print(json.dumps(DEFAULT_CONFIG, indent=2))
+        print(default_config_toml(), end="")
         return 0
     if args.config is None or args.out is None:
         ap.error("--config and --out are required")

@@ -45,95 +45,109 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 PKG = "roughsea_torch"
 
-# The test files that check each module's numbers: those whose tests import or exercise it (coverage
-# per test file, then read), fastest and most discriminating first (``-x`` stops at the first failure).
+# The test files that check each module's numbers, the module's own mirrored file first, then those
+# whose tests exercise it (``-x`` stops at the first failure, so the most discriminating go first).
 # Not used: tests/test_golden.py (it compares renders bit for bit with saved renders of this same
 # code: it fails on ANY change, whether or not a physical number is checked, so it would hide every
-# survivor the mutation pass exists to find), tests/test_readme.py (runs the README's examples) and
-# tests/test_architecture.py (the import layers, not numbers).
-CORE = ["tests/test_published_values.py", "tests/test_torch_core.py", "tests/test_model_physics.py"]
-REFS = ["tests/test_reference_skies_and_indices.py", "tests/test_stability.py", "tests/test_numpy_input_dtype.py",
-        "tests/test_agreement.py"]
-RENDER = ["tests/test_scene_day_storm.py", "tests/test_scene_radiometry_and_camera_pose.py", "tests/test_render.py"]
-WAVES = ["tests/test_waves.py", "tests/test_foam_crests.py", "tests/test_clutter.py"]
-AUGMENT = ["tests/test_validation_textured.py", "tests/test_augmentation_day.py", "tests/test_augmentation_clip.py",
-           "tests/test_augmentation.py"]
+# survivor the mutation pass exists to find), tests/test_readme.py and tests/test_examples.py (run the
+# README's and the examples' code) and tests/test_architecture.py (the import layers, not numbers).
+# the physics core: the expectation, the slope law, optics, radiometry, skies, quadrature
+CORE = ["tests/test_expectation.py", "tests/test_optics.py", "tests/test_slopes.py", "tests/test_radiometry.py",
+        "tests/test_sky.py", "tests/test_atmosphere.py", "tests/test_validation.py", "tests/test_quadrature.py"]
+# the renderer's expectation images: scenes, cameras, the table against per-pixel evaluation
+RENDER = ["tests/renderer/test_scene.py", "tests/renderer/test_api.py", "tests/test_geometry.py",
+          "tests/renderer/test_pixels.py", "tests/renderer/test_sky_terms.py", "tests/renderer/test_table.py",
+          "tests/renderer/test_path.py", "tests/test_sensitivity.py", "tests/renderer/test_coordinates.py",
+          "tests/renderer/test_output.py"]
+# the sun, its glint and the day sky in renders
+DAY = ["tests/test_sun.py", "tests/renderer/test_glint.py", "tests/renderer/test_sky_terms.py"]
+# the wave field and what the textured renderer makes of it
+WAVES = ["tests/test_waves.py", "tests/test_wave_lattice.py", "tests/test_wave_bands.py", "tests/test_clutter.py",
+         "tests/test_foam.py", "tests/renderer/test_texture.py"]
+ATM = ["tests/test_atmosphere.py", "tests/test_lowtran.py", "tests/test_observer_sky.py", "tests/test_solar.py",
+       "tests/test_daysky.py"]
+AUGMENT = ["tests/test_augmentation.py", "tests/test_augmentation_checks.py", "tests/test_sampling.py",
+           "tests/test_parameter_render.py", "tests/test_motion.py"]
+
+
+def _first(own: str | list[str], *groups: list[str]) -> list[str]:
+    """The module's own test file(s) first, then each group's files once, in order."""
+    out: list[str] = []
+    for f in ([own] if isinstance(own, str) else own) + [f for g in groups for f in g]:
+        if f not in out:
+            out.append(f)
+    return out
+
+
 TESTS: dict[str, list[str]] = {
     # foundations
-    "_validation": ["tests/test_validation_textured.py", *CORE, "tests/test_numpy_input_dtype.py",
-                    "tests/test_stability.py", "tests/test_waves.py"],
-    "_parallel": ["tests/test_parallel.py", "tests/test_clutter.py"],
-    "_lookup": ["tests/test_torch_core.py", "tests/test_brightness_temperature_lookup.py", "tests/test_observer_sky.py",
-                "tests/test_atmosphere.py"],
-    "_tables": ["tests/test_solar.py", "tests/test_daysky.py", "tests/test_atmosphere.py", "tests/test_observer_sky.py"],
-    "_sensor_common": ["tests/test_sensor.py", "tests/test_augmentation.py"],
-    "_augmentation_checks": AUGMENT,
+    "_validation": _first("tests/test_validation.py", CORE, ["tests/renderer/test_scene.py", "tests/test_waves.py"]),
+    "_parallel": _first("tests/test_parallel.py", ["tests/test_clutter.py"]),
+    "_lookup": _first(["tests/test_radiometry.py", "tests/test_observer_sky.py"], ATM),
+    "_tables": _first(["tests/test_solar.py", "tests/test_daysky.py"], ATM),
+    "_sensor_common": _first("tests/test_sensor.py", ["tests/test_sensor_noise.py", "tests/test_augmentation.py"]),
+    "_augmentation_checks": _first("tests/test_augmentation_checks.py", AUGMENT),
     # physics
-    "radiometry": ["tests/test_published_values.py", "tests/test_brightness_temperature_lookup.py", "tests/test_torch_core.py",
-                   "tests/test_model_physics.py", "tests/test_stability.py", "tests/test_pixel_derivative.py",
-                   "tests/test_sensor.py", "tests/test_reference_skies_and_indices.py", "tests/test_numpy_input_dtype.py"],
-    "slopes": ["tests/test_slopes.py", *CORE, *REFS],
-    "optics": ["tests/test_band_index_lookup.py", *CORE, "tests/test_scene_radiometry_and_camera_pose.py", *REFS],
-    "sky": ["tests/test_sky.py", "tests/test_torch_core.py", "tests/test_reference_skies_and_indices.py", "tests/test_atmosphere.py",
-            "tests/test_render.py"],
-    "geometry": ["tests/test_scene_radiometry_and_camera_pose.py", "tests/test_render.py", "tests/test_scene_day_storm.py"],
-    "facets": CORE + ["tests/test_sun.py", *REFS],
-    "quadrature": CORE + ["tests/test_expectation.py", *REFS],
-    "expectation": ["tests/test_expectation.py", *CORE, *REFS],
-    "atmosphere": ["tests/test_atmosphere.py", "tests/test_observer_sky.py", "tests/test_torch_core.py",
-                   "tests/test_expectation.py", "tests/test_reference_skies_and_indices.py", "tests/test_render.py"],
-    "lowtran": ["tests/test_atmosphere.py", "tests/test_observer_sky.py", "tests/test_solar.py", "tests/test_daysky.py",
-                "tests/test_render.py"],
-    "observer_sky": ["tests/test_observer_sky.py", "tests/test_atmosphere.py", "tests/test_render.py"],
-    "solar": ["tests/test_solar.py", "tests/test_solar_spectral.py", "tests/test_daysky.py", "tests/test_scene_day_storm.py", "tests/test_sun.py"],
-    "daysky": ["tests/test_daysky.py", "tests/test_scene_day_storm.py", "tests/test_sun.py"],
-    "spectrum": ["tests/test_spectrum.py", *WAVES],
-    "wave_bands": ["tests/test_wave_bands.py", *WAVES],
-    "wave_lattice": WAVES,
+    "radiometry": _first("tests/test_radiometry.py", CORE, ["tests/test_sensitivity.py", "tests/test_sensor.py"]),
+    "slopes": _first("tests/test_slopes.py", CORE, ["tests/test_sun.py"]),
+    "optics": _first("tests/test_optics.py", CORE, ["tests/test_sun.py", "tests/renderer/test_scene.py"]),
+    "sky": _first("tests/test_sky.py", CORE, ["tests/test_lowtran.py"], RENDER),
+    "geometry": _first("tests/test_geometry.py", RENDER, ["tests/test_dataset_config.py"]),
+    "facets": _first("tests/test_expectation.py", CORE, ["tests/test_sun.py", "tests/reference/test_sun.py"]),
+    "quadrature": _first("tests/test_quadrature.py", CORE),
+    "expectation": _first("tests/test_expectation.py", CORE, ["tests/test_sun.py"]),
+    "atmosphere": _first("tests/test_atmosphere.py", ATM, ["tests/test_expectation.py", "tests/test_radiometry.py"], RENDER),
+    "lowtran": _first("tests/test_lowtran.py", ATM, RENDER),
+    "observer_sky": _first("tests/test_observer_sky.py", ATM, RENDER),
+    "solar": _first("tests/test_solar.py", ATM, DAY),
+    "daysky": _first("tests/test_daysky.py", ATM, DAY),
+    "spectrum": _first("tests/test_spectrum.py", WAVES),
+    "wave_bands": _first("tests/test_wave_bands.py", WAVES),
+    "wave_lattice": _first("tests/test_wave_lattice.py", WAVES),
     "waves": WAVES,
-    "sun": ["tests/test_sun.py", "tests/test_scene_day_storm.py", "tests/test_agreement.py"],
-    "foam": ["tests/test_foam.py", "tests/test_foam_crests.py", "tests/test_scene_day_storm.py", "tests/test_sun.py"],
-    "clutter": ["tests/test_clutter.py", "tests/test_foam_crests.py", "tests/test_sun.py"],
+    "sun": _first("tests/test_sun.py", DAY, ["tests/reference/test_sun.py"]),
+    "foam": _first("tests/test_foam.py", ["tests/renderer/test_scene.py", "tests/renderer/test_foam_terms.py"], DAY),
+    "clutter": _first("tests/test_clutter.py", ["tests/test_foam.py", "tests/renderer/test_texture.py", "tests/test_sun.py"]),
+    "raytrace_surface": _first("tests/test_raytrace.py", []),
+    "raytrace": _first("tests/test_raytrace.py", []),
     # renderer
-    "renderer/api": ["tests/test_validation_textured.py", *RENDER, "tests/test_parallel.py"],
-    "renderer/scene": ["tests/test_validation_textured.py", *RENDER],
-    "renderer/plan": [*RENDER, "tests/test_sun.py", "tests/test_clutter.py"],
-    "renderer/coordinates": RENDER + ["tests/test_sun.py"],
-    "renderer/spectral": RENDER + ["tests/test_sun.py"],
-    "renderer/sky_terms": RENDER + ["tests/test_sun.py"],
-    "renderer/path": RENDER,
-    "renderer/foam_terms": RENDER + ["tests/test_foam_crests.py"],
-    "renderer/glint": ["tests/test_scene_day_storm.py", "tests/test_sun.py", "tests/test_augmentation_day.py"],
-    "renderer/texture": ["tests/test_clutter.py", "tests/test_foam_crests.py", "tests/test_sun.py"],
-    "renderer/table": [*RENDER, "tests/test_sun.py", "tests/test_clutter.py"],
-    "renderer/pixels": RENDER,
-    "renderer/direct": RENDER + ["tests/test_sun.py", "tests/test_clutter.py"],
-    "renderer/output": RENDER,
-    "renderer/settings": ["tests/test_validation_textured.py", "tests/test_render.py"],
+    "renderer/api": _first("tests/renderer/test_api.py", RENDER, ["tests/test_parallel.py"]),
+    "renderer/scene": _first("tests/renderer/test_scene.py", RENDER),
+    "renderer/plan": _first("tests/renderer/test_plan.py", RENDER, DAY, ["tests/test_clutter.py"]),
+    "renderer/coordinates": _first("tests/renderer/test_coordinates.py", RENDER, DAY),
+    "renderer/spectral": _first("tests/renderer/test_table.py", RENDER, DAY),
+    "renderer/sky_terms": _first("tests/renderer/test_sky_terms.py", RENDER, DAY),
+    "renderer/path": _first("tests/renderer/test_path.py", RENDER),
+    "renderer/foam_terms": _first("tests/renderer/test_foam_terms.py", RENDER, ["tests/test_foam.py"]),
+    "renderer/glint": _first("tests/renderer/test_glint.py", DAY, ["tests/test_augmentation.py"]),
+    "renderer/texture": _first("tests/renderer/test_texture.py", ["tests/test_clutter.py", "tests/test_foam.py"], DAY),
+    "renderer/hits": _first("tests/renderer/test_hits.py", ["tests/renderer/test_texture.py"]),
+    "renderer/table": _first("tests/renderer/test_table.py", RENDER, DAY, ["tests/test_clutter.py"]),
+    "renderer/pixels": _first("tests/renderer/test_pixels.py", RENDER),
+    "renderer/direct": _first("tests/renderer/test_table.py", RENDER, DAY, ["tests/test_clutter.py"]),
+    "renderer/output": _first("tests/renderer/test_output.py", RENDER),
+    "renderer/settings": _first("tests/renderer/test_settings.py", RENDER),
     # applications
-    "motion": ["tests/test_validation_textured.py", "tests/test_augmentation_clip.py", "tests/test_dataset.py"],
-    "sensitivity": ["tests/test_pixel_derivative.py", "tests/test_render.py"],
-    "sensor": ["tests/test_sensor.py", "tests/test_augmentation.py"],
-    "sensor_noise": ["tests/test_sensor.py", "tests/test_augmentation.py"],
-    "sampling": AUGMENT + ["tests/test_dataset.py"],
-    "parameter_render": AUGMENT + ["tests/test_dataset.py"],
-    "augmentation": AUGMENT,
-    "dataset_config": ["tests/test_dataset.py", "tests/test_scene_radiometry_and_camera_pose.py"],
-    "dataset": ["tests/test_dataset.py"],
+    "motion": _first("tests/test_motion.py", AUGMENT, ["tests/test_dataset.py"]),
+    "sensitivity": _first("tests/test_sensitivity.py", RENDER),
+    "sensor": _first("tests/test_sensor.py", ["tests/test_sensor_noise.py", "tests/test_augmentation.py"]),
+    "sensor_noise": _first("tests/test_sensor_noise.py", ["tests/test_sensor.py", "tests/test_augmentation.py"]),
+    "sampling": _first("tests/test_sampling.py", AUGMENT, ["tests/test_dataset.py"]),
+    "parameter_render": _first("tests/test_parameter_render.py", AUGMENT, ["tests/test_dataset.py"]),
+    "augmentation": _first("tests/test_augmentation.py", AUGMENT),
+    "dataset_config": _first("tests/test_dataset_config.py", ["tests/test_dataset.py", "tests/renderer/test_scene.py"]),
+    "dataset": _first("tests/test_dataset.py", ["tests/test_dataset_config.py"]),
     # reference (numpy)
-    "reference/planck": ["tests/test_published_values.py", "tests/test_model_physics.py", "tests/test_reference_skies_and_indices.py"],
-    "reference/fresnel": ["tests/test_published_values.py", "tests/test_foam.py", "tests/test_model_physics.py",
-                          "tests/test_reference_sun.py", "tests/test_agreement.py"],
-    "reference/slopes": ["tests/test_published_values.py", "tests/test_model_physics.py", "tests/test_reference_sun.py",
-                         "tests/test_agreement.py"],
-    "reference/rough_sea": ["tests/test_published_values.py", "tests/test_model_physics.py",
-                            "tests/test_reference_skies_and_indices.py", "tests/test_reference_sun.py",
-                            "tests/test_agreement.py", "tests/test_reference_shifted.py"],
-    "reference/facet_integral": ["tests/test_published_values.py", "tests/test_model_physics.py",
-                                 "tests/test_reference_skies_and_indices.py", "tests/test_reference_sun.py",
-                                 "tests/test_agreement.py", "tests/test_reference_shifted.py"],
-    "reference/foam": ["tests/test_foam.py"],
-    "reference/sun": ["tests/test_reference_sun.py", "tests/test_agreement.py"],
+    "reference/planck": _first("tests/test_radiometry.py", ["tests/test_expectation.py", "tests/test_optics.py"]),
+    "reference/fresnel": _first("tests/test_optics.py", ["tests/test_expectation.py", "tests/test_foam.py",
+                                                          "tests/reference/test_sun.py"]),
+    "reference/slopes": _first("tests/test_slopes.py", ["tests/test_expectation.py", "tests/reference/test_sun.py"]),
+    "reference/rough_sea": _first("tests/reference/test_rough_sea.py", ["tests/test_expectation.py", "tests/test_optics.py",
+                                                                         "tests/reference/test_sun.py"]),
+    "reference/facet_integral": _first("tests/reference/test_rough_sea.py", ["tests/test_expectation.py",
+                                                                               "tests/reference/test_sun.py"]),
+    "reference/foam": _first("tests/test_foam.py", []),
+    "reference/sun": _first("tests/reference/test_sun.py", ["tests/test_sun.py"]),
 }
 # Modules with nothing to mutate, or not code under test: listed so that every file of the package is accounted for.
 NOT_MUTATED: dict[str, str] = {
@@ -248,6 +262,11 @@ def unmapped(root: Path = ROOT) -> list[str]:
     """Modules of the package that are in neither TESTS nor NOT_MUTATED (the map must follow the layout)."""
     mods = [str(p.relative_to(root / PKG).with_suffix("")) for p in sorted((root / PKG).rglob("*.py"))]
     return [m for m in mods if m not in TESTS and m not in NOT_MUTATED]
+
+
+def missing_test_files(root: Path = ROOT) -> list[str]:
+    """Test files named in TESTS that do not exist (the map must follow the tests' layout)."""
+    return sorted({f for files in TESTS.values() for f in files if not (root / f).is_file()})
 
 
 # -- mutant generation -------------------------------------------------------------------------------
@@ -616,6 +635,9 @@ def main(argv: list[str] | None = None) -> int:
     missing = unmapped()
     if missing:
         ap.error(f"modules of {PKG}/ in neither TESTS nor NOT_MUTATED: {', '.join(missing)}")
+    gone = missing_test_files()
+    if gone:
+        ap.error(f"test files in TESTS that do not exist: {', '.join(gone)}")
     results = load_state(args.report, args.json)
     for m in [m for m in results if m not in TESTS or not (ROOT / module_path(m)).exists()]:
         del results[m]  # a module that no longer exists (e.g. render, _pixels before the renderer package)

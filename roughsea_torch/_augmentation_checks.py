@@ -14,7 +14,7 @@ import torch
 from .sampling import MOTION_FIELD_NAMES, SCENE_FIELD_NAMES
 from .waves import check_time
 
-__all__ = ["check_input", "check_params", "check_output_settings", "REQUIRED_PARAMS", "PER_IMAGE_PARAMS"]
+__all__ = ["check_input", "check_params", "check_output_settings", "check_composite_gate", "REQUIRED_PARAMS", "PER_IMAGE_PARAMS"]
 
 # the per-image fields a draw may hold, each a tensor (B,); the first ones are always there
 REQUIRED_PARAMS = (*SCENE_FIELD_NAMES, "atmosphere", "noise_seed")
@@ -107,3 +107,14 @@ def check_output_settings(mode: str, target_unit: str, sensor: Any, output: str 
     if generator is not None and generator.device.type != "cpu":
         raise ValueError("generator must be a CPU torch.Generator")
     return output
+
+
+def check_composite_gate(mode: str, p: float) -> None:
+    """``ValueError`` naming ``p`` for a compositing augmentation that would leave some inputs out: in
+    composite mode an input is a target chip (value in the target's unit, α), so a chip left out by
+    the gate would come back in that unit beside composited images in the output's unit."""
+    if mode == "composite" and float(p) != 1.0:
+        raise ValueError(f"p must be 1 with mode='composite' (got {p!r}): an input left out would come back as its "
+                         "target chip (a temperature or radiance and an opacity) among images in the output's unit; "
+                         "gate the compositing yourself, or use mode='replace' with p < 1 to mix rendered seas with "
+                         "your own frames")

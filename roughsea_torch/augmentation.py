@@ -43,7 +43,7 @@ from typing import Any, Callable, Sequence
 import torch
 from kornia.augmentation import IntensityAugmentationBase2D
 
-from ._augmentation_checks import check_input, check_output_settings, check_params
+from ._augmentation_checks import check_composite_gate, check_input, check_output_settings, check_params
 from ._parallel import one_thread
 from ._validation import check_finite_range
 from .expectation import Quadrature
@@ -303,7 +303,12 @@ class RandomSeaBackground(RandomSeaBase, IntensityAugmentationBase2D):
 
     Args:
         p, same_on_batch, keepdim: kornia's (images not selected by ``p`` come back unchanged and
-            are not rendered; ``same_on_batch`` repeats the wave seed and time too).
+            are not rendered; ``same_on_batch`` repeats the wave seed and time too). In
+            ``mode="replace"`` an unselected image is the input image itself (e.g. a real frame, in
+            whatever unit the caller keeps it; set ``output`` to match). In ``mode="composite"`` the
+            input is a target chip (value, α), not an image, and a chip left out would come back in
+            the target's unit next to images in the output's: ``p`` must be 1 there (a
+            ``ValueError`` otherwise), so every image of a batch is in one unit.
         wind_speed, ..., generator: the scene, rendering and output arguments shared with
             :class:`RandomSeaClip`, described in :class:`RandomSeaBase` (the scene ranges, ``texture``
             and ``time_s``, ``daytime`` and the sun's ranges, ``band``, ``anisotropic``, ``mode``,
@@ -335,6 +340,7 @@ class RandomSeaBackground(RandomSeaBase, IntensityAugmentationBase2D):
         _check_keywords(type(self), shared)
         super().__init__(p=p, same_on_batch=same_on_batch, keepdim=keepdim)
         self._set_up(None, **shared)
+        check_composite_gate(self.mode, p)
 
     def forward(self, input: torch.Tensor, params: dict[str, torch.Tensor] | None = None,
                 generator: torch.Generator | None = None, **kwargs: Any) -> torch.Tensor:
@@ -465,6 +471,7 @@ class RandomSeaClip(RandomSeaBase, torch.nn.Module):
                       heave_amplitude_m=heave_amplitude_m, pitch_period_s=pitch_period_s, roll_period_s=roll_period_s,
                       heave_period_s=heave_period_s)
         self._set_up(motion, **shared)
+        check_composite_gate(self.mode, p)
         self.frame_rate = float(frame_rate)
         self.data_format = fmt
         self.p = float(p)

@@ -49,6 +49,7 @@ import io
 import json
 import math
 import os
+import warnings
 from pathlib import Path
 from typing import Any, Callable, Iterator
 
@@ -202,11 +203,16 @@ class _ShardJobs(torch.utils.data.Dataset):
         k = self.shards[i]
         if self.sensor is None:
             self.sensor = build_sensor(self.cfg)
-        arrays = render_shard(self.cfg, k, self.sensor)
+        # the shard's warnings go back with its entry, for generate to raise in the caller's process at
+        # the caller's line (raised here, in a worker process, they pointed into multiprocessing)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            arrays = render_shard(self.cfg, k, self.sensor)
         path = self.out / shard_name(k)
         crash = 100 if self.crash is not None and i >= self.crash else None
         _atomic_write(path, lambda f: np.savez(f, **arrays), crash_after_bytes=crash)
-        return {"shard": k, "file": path.name, "images": int(arrays["images"].shape[0]), "sha256": _sha256(path)}
+        return {"shard": k, "file": path.name, "images": int(arrays["images"].shape[0]), "sha256": _sha256(path),
+                "warnings": [(w.category, str(w.message)) for w in caught]}
 
 
 def num_shards(cfg: dict[str, Any]) -> int:
@@ -314,6 +320,8 @@ def generate(
                                              persistent_workers=False)
         bar = _progress_bar(cfg, todo, rank) if progress else None
         for entry in loader:
+            for category, message in entry.pop("warnings"):  # the shard's, at the caller's line (once per text)
+                warnings.warn(message, category, stacklevel=2)
             done[entry["shard"]] = entry
             manifest["shards"] = [done[k] for k in sorted(done)]
             _write_json(manifest_path, manifest)

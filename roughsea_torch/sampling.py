@@ -27,6 +27,7 @@ from ._validation import check_finite_range
 from .atmosphere import available_atmospheres, load_path, surface_air_temperature
 from .motion import PlatformMotion
 from .radiometry import LWIR, as_band
+from .slopes import MAX_WIND_SPEED
 
 __all__ = [
     "SceneSampler",
@@ -45,7 +46,7 @@ __all__ = [
 
 # (name, allowed range, unit, default range); the order is the order of the draws
 SCENE_FIELDS: tuple[tuple[str, tuple[float, float], str, Any], ...] = (
-    ("wind_speed", (0.0, 40.0), "m/s", (1.0, 15.0)),
+    ("wind_speed", (0.0, MAX_WIND_SPEED), "m/s", (1.0, 15.0)),
     ("wind_direction_deg", (-3600.0, 3600.0), "deg", (0.0, 360.0)),
     ("sea_temperature", (260.0, 320.0), "K", (285.0, 300.0)),
     ("air_temperature", (230.0, 330.0), "K", None),
@@ -146,7 +147,8 @@ class SceneSampler:
     defaults are in :data:`SCENE_FIELDS` and :data:`MOTION_FIELDS`:
 
     Args:
-        wind_speed: W [m s⁻¹], in [0, 40] (Cox–Munk was fitted up to ~14 m s⁻¹).
+        wind_speed: W [m s⁻¹], in [0, 80] (``slopes.MAX_WIND_SPEED``, the package's one range;
+            Cox–Munk was fitted up to ~14 m s⁻¹).
         wind_direction_deg: upwind azimuth [deg] in the world frame.
         sea_temperature: T_sea [K], in [260, 320].
         air_temperature: T_air [K] of the surface air, in [230, 330]; ``None`` (default): each

@@ -12,13 +12,21 @@ zero wind has a = 0): keeping Σ keeps gradients with respect to wind speed fini
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import torch
 
 from ._validation import as_tensor, check_finite_range, resolve_dtype_device
 
-__all__ = ["SlopeStatistics", "slope_pdf"]
+__all__ = ["SlopeStatistics", "slope_pdf", "MAX_WIND_SPEED"]
+
+# [m s⁻¹] The one range of wind speeds the package accepts, [0, 80] (SlopeStatistics.cox_munk, SeaScene,
+# WaveField, the augmentations' draws). The laws are fitted over less: Cox & Munk (1954) measured up to
+# ~14 m/s, Elfouhaily et al.'s spectrum (1997) is fitted to ~20 m/s, Monahan & O'Muircheartaigh's whitecap
+# law (1980) to ~20–25 m/s; above that the package extrapolates them (a hurricane's 80 m/s is the bound
+# where the Cox–Munk rms slope, 0.64, still describes a surface of slopes). Winds below 0 or NaN are errors.
+MAX_WIND_SPEED = 80.0
 
 Number = float | int
 
@@ -101,9 +109,22 @@ class SlopeStatistics:
         - isotropic (the paper's Eq. 12): σ² = 0.003 + 5.12·10⁻³ W, a² = b² = σ²/2;
         - anisotropic: upwind a² = 3.16·10⁻³ W, crosswind b² = 0.003 + 1.92·10⁻³ W, r = 0.
 
-        W = 0 is not a flat sea (σ² = 0.003); a flat sea is ``SlopeStatistics(0, 0)``.
+        W = 0 is not a flat sea (σ² = 0.003); a flat sea is ``SlopeStatistics(0, 0)``. The anisotropic
+        law's upwind variance vanishes at W = 0, and the rms slope along a view near the wind axis with it
+        as √W: asking for autograd's wind gradient there (a ``wind_speed`` tensor that requires grad,
+        with a 0) warns, as it comes back finite but is not the derivative
+        (``docs/gradient_accuracy.md``). W in [0, :data:`MAX_WIND_SPEED`] (a ``ValueError``
+        otherwise); the laws are measured up to ~14 m/s and extrapolated above.
         """
-        check_finite_range("wind_speed", wind_speed, 0.0, unit="m/s")
+        check_finite_range("wind_speed", wind_speed, 0.0, MAX_WIND_SPEED, unit="m/s")
+        if (anisotropic and isinstance(wind_speed, torch.Tensor) and wind_speed.requires_grad and torch.is_grad_enabled()
+                and bool((wind_speed.detach() == 0).any())):
+            warnings.warn("SlopeStatistics.cox_munk(anisotropic=True): at wind_speed = 0 the upwind slope variance "
+                          "3.16e-3 W vanishes and the rms slope along a view varies as sqrt(W) near the wind axis, "
+                          "where R_a has no derivative in the wind for autograd to follow: the gradient comes back "
+                          "finite but is not the derivative (0 along the wind axis where a one-sided finite "
+                          "difference gives several K per m/s; up to ~1e3 K per m/s off by the table method). "
+                          "Differentiate at W >= ~0.1 m/s, or take a one-sided finite difference.", stacklevel=2)
         if anisotropic:
             return cls.from_variances(3.16e-3 * wind_speed, 0.003 + 1.92e-3 * wind_speed, 0.0)
         return cls.isotropic(0.003 + 5.12e-3 * wind_speed)

@@ -59,6 +59,7 @@ from typing import Any
 import torch
 
 from ._validation import as_tensor, check_finite_range, resolve_dtype_device
+from .slopes import MAX_WIND_SPEED
 
 __all__ = [
     "GRAVITY",
@@ -79,7 +80,7 @@ GRAVITY = 9.81  # g [m s⁻²]
 K_M = 370.0  # k_m, wavenumber of the phase-speed minimum [rad m⁻¹] (ECKV text below Eq. 40)
 C_M = 0.23  # c_m, minimum phase speed [m s⁻¹] (ECKV text below Eq. 40)
 VON_KARMAN = 0.41  # κ in u* = κ U10 / ln(10/z0) (ECKV Eq. 60)
-MAX_WIND = 80.0  # [m s⁻¹] upper bound accepted for U10
+MAX_WIND = MAX_WIND_SPEED  # [m s⁻¹] upper bound accepted for U10: the package's one range (slopes.MAX_WIND_SPEED)
 _A0 = math.log(2.0) / 4.0  # a_0 (ECKV Eq. 59)
 _AP = 4.0  # a_p (ECKV Eq. 59)
 

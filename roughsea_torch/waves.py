@@ -339,8 +339,8 @@ class WaveField:
             raise ValueError(f"footprint must lie in [0, inf] m and not be NaN; got {bad!r}")
         return f
 
-    def _tiles(self, time_s: torch.Tensor, elevation: bool, crest: bool = False) -> torch.Tensor:
-        """Band tiles at the given times, (n_bands, B, C, N+1, N+1); C = (η,) s_x, s_y (, X)."""
+    def _tiles(self, time_s: torch.Tensor, elevation: bool, crest: bool = False, slopes: bool = True) -> torch.Tensor:
+        """Band tiles at the given times, (n_bands, B, C, N+1, N+1); C = (η,) (s_x, s_y) (, X)."""
         tiles = []
         lat = self._lattice
         kx = lat.kx.to(self.dtype)
@@ -351,7 +351,7 @@ class WaveField:
             rot = torch.complex(cos, -self._sign[b] * sin).to(self._h0[b].dtype)  # exp(−i s ω t)
             h = self._h0[b] * rot
             minus_i_h = torch.complex(h.imag, -h.real)  # −i H
-            channels = [minus_i_h * kx, minus_i_h * ky]
+            channels = [minus_i_h * kx, minus_i_h * ky] if slopes else []
             if elevation:
                 channels.insert(0, h)
             if crest:
@@ -418,21 +418,22 @@ class WaveField:
         return self.sample_unchecked(xt, yt, t_s, f, elevation, crest)
 
     def sample_unchecked(self, xt: torch.Tensor, yt: torch.Tensor, t_s: torch.Tensor, f: torch.Tensor | None,
-                         elevation: bool, crest: bool) -> dict[str, torch.Tensor]:
+                         elevation: bool, crest: bool, slopes: bool = True) -> dict[str, torch.Tensor]:
         """:meth:`sample` without its input checks, for callers whose arguments are checked already (the
         renderer's own pixels): ``xt``, ``yt`` (B, ...) of the field's dtype and device, finite; times
         ``t_s`` (B,) float64 within ±MAX_TIME_S; footprints ``f`` of x's shape (≥ 0) or None. Returns what
-        :meth:`sample` returns; unchecked input gives unchecked output (NaN, wrong shapes)."""
+        :meth:`sample` returns (without the slopes with ``slopes=False``: the elevation alone costs a
+        third of the three channels); unchecked input gives unchecked output (NaN, wrong shapes)."""
         shape = xt.shape
         batch = self.batch_size
         npts = int(np.prod(shape[1:])) if len(shape) > 1 else 1
-        names = (["elevation"] if elevation else []) + ["slope_x", "slope_y"] + (["crest"] if crest else [])
+        names = (["elevation"] if elevation else []) + (["slope_x", "slope_y"] if slopes else []) + (["crest"] if crest else [])
         if npts == 0:
             return {name: xt.new_zeros(shape) for name in names}
         xy = torch.stack((xt.reshape(batch, npts), yt.reshape(batch, npts)), dim=-1)  # (B, P, 2)
         if f is not None:
             f = f.reshape(batch, npts)
-        tiles = self._tiles(t_s, elevation, crest)
+        tiles = self._tiles(t_s, elevation, crest, slopes)
         acc = self._sample_points(tiles, xy, f)
         return {name: acc[:, c].reshape(shape) for c, name in enumerate(names)}
 

@@ -1,5 +1,12 @@
-"""RandomSeaBackground and SceneSampler: kornia conventions, reproducibility, and physics of the
-compositing and of the parameters' plumbing into the renderer."""
+"""The random-sea augmentations (roughsea_torch.augmentation): RandomSeaBackground for still images
+and RandomSeaClip for clips. Kornia conventions (shapes, layouts, masks and boxes in
+AugmentationSequential, VideoSequential), reproducibility (replay from the kept parameters, seeds,
+DataLoader workers), the physics of the compositing (alpha blending in radiance) and of the parameters'
+plumbing into the renderer; clips: temporal coherence of the sea, the platform's motion in the image,
+frames that equal still images rendered at their pose and time; day images: ``daytime`` draws
+whether an image is by day and where its sun is; on, the sun's glint is in the images and replays
+bit for bit. (The draws themselves: tests/test_sampling.py; the checks of inputs and replayed draws:
+tests/test_augmentation_checks.py.)"""
 
 from __future__ import annotations
 
@@ -10,9 +17,18 @@ import pytest
 import torch
 
 import roughsea_torch as rs
-from roughsea_torch.augmentation import RandomSeaBackground, SceneSampler, render_parameters
+from roughsea_torch.augmentation import (
+    RandomSeaBackground,
+    RandomSeaClip,
+    frame_noise_seed,
+    frame_parameters,
+    render_parameters,
+)
+
+from conftest import gen
 
 H, W = 24, 32
+STILL = dict(pitch_amplitude_deg=0.0, roll_amplitude_deg=0.0, heave_amplitude_m=0.0)  # a camera that does not move
 
 
 def small(**kw):
@@ -20,7 +36,14 @@ def small(**kw):
     return RandomSeaBackground(**kw)
 
 
-@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+def clip(**kw):
+    kw.setdefault("output", "brightness_temperature")
+    return RandomSeaClip(**kw)
+
+
+# ------------------------------------------------------------------------------------------------
+# Still images: RandomSeaBackground
+# ------------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("channels", [1, 3])
 def test_shape_dtype_and_values(dtype, channels):
     aug = small(sea_temperature=(285.0, 300.0))
@@ -52,32 +75,6 @@ def test_replay_and_seeding():
     c = aug(x)
     torch.manual_seed(3)
     assert torch.equal(aug(x), c)  # no generator: the global one
-
-
-def test_draws_within_ranges_and_fixed_values():
-    s = SceneSampler(wind_speed=(2.0, 4.0), pitch_deg=-3.0, hfov_deg=(10.0, 12.0), atmospheres=["tropical", "us_standard"])
-    p = s.sample(500, generator=torch.Generator().manual_seed(0))
-    assert bool(((p["wind_speed"] >= 2.0) & (p["wind_speed"] <= 4.0)).all())
-    assert float(p["wind_speed"].max() - p["wind_speed"].min()) > 1.9  # spread over the range
-    assert torch.equal(p["pitch_deg"], torch.full((500,), -3.0, dtype=torch.float64))
-    assert set(p["atmosphere"].tolist()) == {0, 1}
-    # air temperature left out: each image gets its atmosphere's own surface air temperature
-    own = torch.tensor([rs.atmosphere.surface_air_temperature(n) for n in ("tropical", "us_standard")], dtype=torch.float64)
-    assert torch.equal(p["air_temperature"], own[p["atmosphere"]])
-    # fixing one range does not change the draws of the others
-    q = SceneSampler(wind_speed=(2.0, 4.0), pitch_deg=(-5.0, -1.0), hfov_deg=(10.0, 12.0),
-                     atmospheres=["tropical", "us_standard"]).sample(500, generator=torch.Generator().manual_seed(0))
-    assert torch.equal(p["wind_speed"], q["wind_speed"]) and torch.equal(p["hfov_deg"], q["hfov_deg"])
-
-
-def test_indexed_draws_do_not_depend_on_the_batch():
-    s = SceneSampler()
-    a = s.sample_indexed(11, [5, 6, 7])
-    b = s.sample_indexed(11, [7])
-    for k in a:
-        assert torch.equal(a[k][2:], b[k])
-    c = s.sample_indexed(12, [7])
-    assert not torch.equal(c["wind_speed"], b["wind_speed"])
 
 
 def test_same_on_batch():
@@ -115,69 +112,6 @@ def test_inside_augmentation_sequential_with_masks_and_boxes():
     assert torch.allclose(b2[..., 0], W - 1 - boxes[..., 2]) and torch.allclose(b2[..., 2], W - 1 - boxes[..., 0])  # kornia: x -> W - 1 - x
     y2, m3, _ = seq(x, m, boxes, params=seq._params)
     assert torch.equal(y2, y) and torch.equal(m3, m2)
-
-
-def test_rendering_matches_an_explicit_scene():
-    """The parameters reach the renderer in the documented units (wind direction in degrees,
-    per-image atmospheres): a mixed-atmosphere batch equals each image rendered on its own."""
-    s = SceneSampler(atmospheres=["tropical", "midlatitude_winter"], air_temperature=(270.0, 300.0),
-                     yaw_deg=(-180.0, 180.0), pitch_deg=(-25.0, -2.0))
-    p = s.sample(4, generator=torch.Generator().manual_seed(9))
-    p["atmosphere"] = torch.tensor([0, 1, 0, 1])
-    img = render_parameters(p, H, W, s.atmospheres, dtype=torch.float64)
-    no_path = render_parameters(p, H, W, s.atmospheres, dtype=torch.float64, path=False)
-    for i in range(4):
-        cam = rs.make_camera(H, W, hfov_deg=float(p["hfov_deg"][i]), altitude_m=float(p["altitude_m"][i]),
-                             pitch_deg=float(p["pitch_deg"][i]), yaw_deg=float(p["yaw_deg"][i]),
-                             roll_deg=float(p["roll_deg"][i]), dtype=torch.float64)
-        scene = rs.SeaScene(wind_speed=float(p["wind_speed"][i]), wind_direction=math.radians(float(p["wind_direction_deg"][i])),
-                            sea_temperature=float(p["sea_temperature"][i]), air_temperature=float(p["air_temperature"][i]),
-                            sky=s.atmospheres[int(p["atmosphere"][i])])
-        ref = rs.render(cam, scene)
-        torch.testing.assert_close(img[i : i + 1], ref, rtol=1e-7, atol=0.0)  # batching order only
-        scene.path = None
-        torch.testing.assert_close(no_path[i : i + 1], rs.render(cam, scene), rtol=1e-7, atol=0.0)
-    assert not torch.allclose(img, no_path)
-
-
-def test_textured_parameters_reach_the_renderer():
-    """A textured draw renders, image by image, ``SeaScene(seed=wave_seed, time_s=time_s)``: the
-    seed and the time [s] reach the renderer (and the batch does not change an image)."""
-    s = SceneSampler(atmospheres=["tropical", "us_standard"], wind_speed=(4.0, 12.0), pitch_deg=(-15.0, -5.0),
-                     altitude_m=(10.0, 30.0), texture=True)
-    p = s.sample(3, generator=torch.Generator().manual_seed(4))
-    img = render_parameters(p, H, W, s.atmospheres, dtype=torch.float64)
-    for i in range(3):
-        cam = rs.make_camera(H, W, hfov_deg=float(p["hfov_deg"][i]), altitude_m=float(p["altitude_m"][i]),
-                             pitch_deg=float(p["pitch_deg"][i]), yaw_deg=float(p["yaw_deg"][i]),
-                             roll_deg=float(p["roll_deg"][i]), dtype=torch.float64)
-        scene = rs.SeaScene(wind_speed=float(p["wind_speed"][i]), wind_direction=math.radians(float(p["wind_direction_deg"][i])),
-                            sea_temperature=float(p["sea_temperature"][i]), sky=s.atmospheres[int(p["atmosphere"][i])],
-                            seed=int(p["wave_seed"][i]), time_s=float(p["time_s"][i]))
-        torch.testing.assert_close(img[i : i + 1], rs.render(cam, scene), rtol=1e-7, atol=0.0)
-        scene.time_s = float(p["time_s"][i]) + 5.0  # another moment of the same sea is another image
-        assert not torch.allclose(img[i : i + 1], rs.render(cam, scene), rtol=1e-5, atol=0.0)
-
-
-def test_texture_draws_come_after_the_old_ones():
-    """Texture adds a wave seed (int64) and a time (float64, within time_s) per image, drawn after
-    the other parameters: with the same generator seed, every other draw is what texture=False
-    (the behaviour before texture existed) draws."""
-    g = lambda: torch.Generator().manual_seed(21)  # noqa: E731
-    off = SceneSampler(atmospheres=["tropical", "us_standard"]).sample(64, generator=g())
-    on = SceneSampler(atmospheres=["tropical", "us_standard"], texture=True, time_s=(100.0, 200.0)).sample(64, generator=g())
-    assert set(on) - set(off) == {"wave_seed", "time_s"}
-    assert all(torch.equal(off[k], on[k]) for k in off)
-    assert on["wave_seed"].dtype == torch.int64 and len(set(on["wave_seed"].tolist())) == 64
-    assert on["time_s"].dtype == torch.float64
-    assert bool(((on["time_s"] >= 100.0) & (on["time_s"] < 200.0)).all()) and float(on["time_s"].std()) > 20.0
-    # the same through the augmentation: texture on and off share the scenes
-    a = small(generator=torch.Generator().manual_seed(5))
-    b = small(generator=torch.Generator().manual_seed(5), texture=False)
-    a(torch.zeros(2, 1, H, W))
-    b(torch.zeros(2, 1, H, W))
-    assert "wave_seed" not in b._params
-    assert all(torch.equal(a._params[k], b._params[k]) for k in off)
 
 
 def test_texture_replays_bit_for_bit_and_differs_between_draws():
@@ -241,7 +175,6 @@ def test_calm_sea_is_the_expectation_image():
     assert not torch.allclose(m[1:], ref[1:], rtol=0, atol=1e-3)  # the windy one is textured
 
 
-@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
 def test_composite_is_alpha_blending_in_radiance(dtype):
     aug = RandomSeaBackground(mode="composite", output="radiance")
     x = torch.zeros(2, 2, H, W, dtype=dtype)
@@ -387,45 +320,6 @@ def test_dataloader_workers_draw_their_own_scenes():
     assert torch.equal(aug(torch.zeros(2, 1, 16, 20), params=aug._params), y)
 
 
-@pytest.mark.parametrize("dtype", [torch.float16, torch.bfloat16])
-@pytest.mark.parametrize("mode", ["replace", "composite"])
-def test_half_precision_input_is_refused(dtype, mode):
-    """float16 steps are 0.25 K near 290 K (rounding by up to 0.125 K, against a 0.05 K NETD) and hold integers
-    exactly only to 2048: the output cannot carry the result in the input's dtype."""
-    assert float(torch.tensor(290.0, dtype=torch.float16).nextafter(torch.tensor(300.0, dtype=torch.float16)) - 290.0) == 0.25
-    x = torch.zeros(1, 2 if mode == "composite" else 1, H, W, dtype=dtype)
-    with pytest.raises(ValueError, match=r"input: dtype .*float32"):
-        RandomSeaBackground(mode=mode, output="brightness_temperature")(x)
-
-
-@pytest.mark.parametrize("bad", [2.0, -0.1, float("nan")])
-def test_alpha_outside_the_unit_interval_is_refused(bad):
-    x = torch.zeros(2, 2, H, W)
-    x[:, 0] = 300.0
-    x[1, 1, 3, 4] = bad
-    with pytest.raises(ValueError, match=r"alpha \(input channel 1.*\[0, 1\]"):
-        RandomSeaBackground(mode="composite", output="radiance")(x)
-    x[1, 1, 3, 4] = 1.0  # the edges of the range are fine
-    RandomSeaBackground(mode="composite", output="radiance")(x)
-
-
-@pytest.mark.parametrize("altitude", [(0.5, 100.0), (10.0, 6000.0), 1.0])
-def test_altitudes_outside_the_path_tables_are_refused(altitude):
-    """The path tables cover camera altitudes 2 m – 5 km: with the path on, a range leaving them is
-    refused at construction (naming altitude_m and the allowed range); with path=False the
-    sampler's wider 0.5 m – 20 km stays allowed."""
-    lo, hi = rs.atmosphere.load_path("tropical").altitude_range_m
-    assert (lo, hi) == (2.0, 5000.0)
-    for make in (lambda **k: RandomSeaBackground(atmospheres=["tropical", "us_standard"], **k),
-                 lambda **k: SceneSampler(atmospheres=["tropical", "us_standard"], **k)):
-        with pytest.raises(ValueError, match=r"altitude_m.*\[2, 5000\] m"):
-            make(altitude_m=altitude)
-        make(altitude_m=altitude, path=False)
-        make(altitude_m=(2.0, 5000.0))
-    with pytest.raises(ValueError, match="altitude_m"):
-        SceneSampler(altitude_m=(0.1, 10.0), path=False)  # below the sampler's own 0.5 m
-
-
 def test_foam_setting_reaches_the_rendered_seas():
     """RandomSeaBackground(foam=False) renders seas without whitecaps (the user's switch for the
     model's dark whitecaps near grazing): its images are render_parameters(..., foam=False) of its
@@ -491,3 +385,225 @@ def test_constructors_list_their_arguments():
     for cls in (RandomSeaBackground, RandomSeaClip):
         with pytest.raises(TypeError, match=rf"^{cls.__name__}\.__init__\(\) got an unexpected keyword argument 'wind'$"):
             cls(wind=3.0, p=0.5)
+
+
+# ------------------------------------------------------------------------------------------------
+# Clips: RandomSeaClip
+# ------------------------------------------------------------------------------------------------
+def test_layouts_and_replay():
+    """BTCHW and BCTHW hold the same clip (the output keeps the input's layout); a replay from the
+    kept parameters is bit for bit, and every clip has its own wave seed and start time."""
+    a = clip(frame_rate=25.0, wind_speed=(5.0, 12.0))
+    x = torch.zeros(2, 2, 2, H, W)  # B, T, C, H, W
+    y = a(x, generator=torch.Generator().manual_seed(0))
+    assert y.shape == x.shape and y.dtype == x.dtype
+    assert torch.equal(y[:, :, :1], y[:, :, 1:])  # channels repeat the rendered frame
+    assert torch.equal(a(x, params={k: v.clone() for k, v in a._params.items()}), y)
+    assert a._params["wave_seed"].shape == (2,) and a._params["wave_seed"][0] != a._params["wave_seed"][1]
+    b = clip(frame_rate=25.0, wind_speed=(5.0, 12.0), data_format="bcthw")
+    z = b(x.transpose(1, 2), generator=torch.Generator().manual_seed(0))
+    assert z.shape == (2, 2, 2, H, W) and torch.equal(z.transpose(1, 2), y)
+    assert not torch.equal(y[:, 0], y[:, 1])  # the frames are not one image repeated
+
+
+def test_frames_are_stills_at_their_pose_and_time():
+    """Frame t of a clip is the still image of the clip's scene at the frame's pose and time
+    (frame_parameters): the motion and the time reach the renderer, nothing else differs."""
+    a = clip(frame_rate=2.0, wind_speed=8.0, pitch_deg=-6.0, altitude_m=15.0, pitch_amplitude_deg=2.0,
+             roll_amplitude_deg=4.0, heave_amplitude_m=1.0)
+    T = 3
+    y = a(torch.zeros(1, T, 1, H, W), generator=torch.Generator().manual_seed(3))
+    f = frame_parameters(a._params, T, 2.0)
+    torch.testing.assert_close(f["time_s"][0], a._params["time_s"][0] + torch.tensor([0.0, 0.5, 1.0], dtype=torch.float64),
+                               rtol=0, atol=1e-9)
+    p = a._params
+    # the pose is PlatformMotion's at t / frame_rate (pitch: amplitude · sin(2π t / T_p + φ) about the mean)
+    want = p["pitch_deg"] + p["pitch_amplitude_deg"] * torch.sin(2 * math.pi * 0.5 / p["pitch_period_s"] + p["phase_rad"])
+    torch.testing.assert_close(f["pitch_deg"][:, 1], want, rtol=0, atol=1e-12)
+    assert f["noise_seed"][0, 0] == p["noise_seed"][0] and f["noise_seed"][0, 2] == frame_noise_seed(int(p["noise_seed"][0]), 2)
+    for t in range(T):
+        still = {k: v for k, v in p.items() if isinstance(v, torch.Tensor) and v.ndim == 1 and v.shape[0] == 1}
+        still.update({k: f[k][:, t] for k in ("pitch_deg", "roll_deg", "altitude_m", "time_s")})
+        L = render_parameters(still, H, W, a.sampler.atmospheres)
+        assert torch.equal(rs.brightness_temperature(L, rs.LWIR), y[:, t])
+
+
+def test_consecutive_frames_are_coherent():
+    """The same sea 40 ms later (25 Hz) differs far less than 10 s later, when the waves at near
+    range have moved by many wavelengths; the sky does not change with time."""
+    kw = dict(wind_speed=(5.0, 12.0), pitch_deg=-15.0, altitude_m=10.0, roll_deg=0.0, hfov_deg=30.0, **STILL)
+    fast = clip(frame_rate=25.0, **kw)
+    x = torch.zeros(3, 2, 1, H, W)
+    a = fast(x, generator=torch.Generator().manual_seed(0))
+    b = clip(frame_rate=0.1, **kw)(x, params=fast._params)  # the same clips, frames 10 s apart
+    assert torch.equal(a[:, 0], b[:, 0])
+    sea = rs.view_geometry(rs.make_camera(H, W, hfov_deg=30.0, altitude_m=10.0, pitch_deg=-15.0)).is_sea[0]
+    for i in range(3):
+        near = float((a[i, 1, 0] - a[i, 0, 0])[sea].pow(2).mean().sqrt())
+        far = float((b[i, 1, 0] - b[i, 0, 0])[sea].pow(2).mean().sqrt())
+        assert 0.01 < far < 3.0  # K: decorrelated clutter
+        assert near < 0.3 * far
+        assert torch.equal(a[i, 1, 0][~sea], a[i, 0, 0][~sea])
+
+
+def test_pitch_motion_moves_the_horizon():
+    """A pitching camera (2°, 4 s period, sampled at 1 Hz): the horizon (the row where the warm
+    sky near the horizon gives way to the sea, the largest drop of the row-mean brightness
+    temperature) moves between frames by f · Δtan(pitch), f the focal length in pixels."""
+    h, hfov = 48, 20.0
+    a = clip(frame_rate=1.0, pitch_amplitude_deg=2.0, pitch_period_s=4.0, roll_amplitude_deg=0.0, heave_amplitude_m=0.0,
+             pitch_deg=0.0, roll_deg=0.0, hfov_deg=hfov, altitude_m=20.0, wind_speed=8.0,
+             generator=torch.Generator().manual_seed(0))
+    params = a.generate_parameters(1)
+    params["phase_rad"] = torch.tensor([0.0], dtype=torch.float64)  # pitch 0°, +2°, 0°, −2°, ...
+    y = a(torch.zeros(1, 4, 1, h, W), params=params)
+    pitch = frame_parameters(params, 4, 1.0)["pitch_deg"][0]
+    torch.testing.assert_close(pitch, torch.tensor([0.0, 2.0, 0.0, -2.0], dtype=torch.float64), rtol=0, atol=1e-12)
+    profile = y[0, :, 0].double().mean(-1)  # (T, H)
+    rows = (profile[:, :-1] - profile[:, 1:]).argmax(-1).double()  # the drop between row r and r + 1
+    f = (W / 2) / math.tan(math.radians(hfov / 2))
+    dip = math.acos(rs.EARTH_RADIUS_M / (rs.EARTH_RADIUS_M + 20.0))
+    want = torch.tensor([f * math.tan(math.radians(p) + dip) for p in pitch.tolist()], dtype=torch.float64)
+    shift = rows - rows[0]  # looking up moves the horizon down the image (larger row)
+    assert abs(float(shift[1] - (want[1] - want[0]))) <= 1.0 and abs(float(shift[3] - (want[3] - want[0]))) <= 1.0
+    assert float(shift[1]) >= 2.0 and float(shift[3]) <= -2.0 and abs(float(shift[2])) <= 1.0
+
+
+def test_composite_p_and_video_sequential():
+    """Targets composite frame by frame (an opaque 320 K patch reads 320 K in every frame, alpha
+    passes through); p gates whole clips; frame-wise kornia augmentations go after it."""
+    a = clip(frame_rate=10.0, mode="composite", wind_speed=8.0)
+    x = torch.zeros(2, 3, 2, H, W)
+    x[:, :, 0] = 320.0
+    x[:, :, 1, 2:6, 3:9] = 1.0
+    y = a(x, generator=torch.Generator().manual_seed(1))
+    torch.testing.assert_close(y[:, :, 0, 2:6, 3:9], torch.full((2, 3, 4, 6), 320.0), rtol=0, atol=1e-3)
+    assert torch.equal(y[:, :, 1], x[:, :, 1])
+    assert float((y[:, :, 0, 10:] - 320.0).abs().min()) > 5.0  # the sea, not the target, elsewhere
+    g = clip(frame_rate=10.0, p=0.5, wind_speed=8.0)
+    z = g(torch.full((8, 2, 1, H, W), -1.0), generator=torch.Generator().manual_seed(2))
+    keep = g._params["batch_prob"] > 0.5
+    assert 0 < int(keep.sum()) < 8
+    assert bool((z[~keep] == -1.0).all()) and bool((z[keep] > 200.0).all())
+    seq = K.VideoSequential(K.RandomHorizontalFlip(p=1.0), data_format="BTCHW")
+    v = clip(frame_rate=10.0, wind_speed=8.0)
+    c = v(torch.zeros(1, 2, 1, H, W), generator=torch.Generator().manual_seed(3))
+    assert torch.equal(seq(c), c.flip(-1))
+
+
+def test_sensor_noise_changes_from_frame_to_frame():
+    """With a still camera over the expectation sea (texture off) two frames differ only by the
+    sensor's temporal noise: about √2 · NETD rms in kelvin, not zero."""
+    from roughsea_torch.sensor import DetectorNoise, SensorModel
+
+    netd = 0.05
+    a = RandomSeaClip(frame_rate=25.0, texture=False, sensor=SensorModel(noise=DetectorNoise(netd_k=netd)),
+                      pitch_deg=-10.0, **STILL)
+    y = a(torch.zeros(2, 2, 1, H, W, dtype=torch.float64), generator=torch.Generator().manual_seed(4))
+    bt = rs.brightness_temperature(y[:, :, 0], rs.LWIR)
+    rms = float((bt[:, 1] - bt[:, 0]).pow(2).mean().sqrt())
+    assert 0.8 * math.sqrt(2) * netd < rms < 1.2 * math.sqrt(2) * netd
+    assert torch.equal(a(torch.zeros(2, 2, 1, H, W, dtype=torch.float64), params=a._params), y)
+
+
+@pytest.mark.parametrize(
+    "kwargs, key",
+    [
+        (dict(frame_rate=0.0), "frame_rate"),
+        (dict(frame_rate=float("nan")), "frame_rate"),
+        (dict(data_format="BCHW"), "data_format"),
+        (dict(heave_amplitude_m=(0.0, 12.0), altitude_m=(10.0, 20.0)), "heave_amplitude_m"),
+        (dict(pitch_amplitude_deg=5.0, pitch_deg=(-88.0, -1.0)), "pitch_amplitude_deg"),
+        (dict(roll_period_s=(0.0, 5.0)), "roll_period_s"),
+        (dict(pitch_amplitude_deg=(3.0, 1.0)), "pitch_amplitude_deg"),
+        (dict(p=1.5), "p"),
+        (dict(texture=1), "texture"),
+    ],
+)
+def test_clip_bad_arguments_name_the_key(kwargs, key):
+    with pytest.raises(ValueError, match=key):
+        RandomSeaClip(**kwargs)
+
+
+def test_bad_input_is_refused():
+    with pytest.raises(ValueError, match=r"input must be a 5-D clip B, T, C, H, W"):
+        clip()(torch.zeros(2, 1, H, W))
+    with pytest.raises(ValueError, match="2 channels"):
+        clip(mode="composite")(torch.zeros(1, 2, 1, H, W))
+    with pytest.raises(ValueError, match=r"input: dtype"):
+        clip()(torch.zeros(1, 2, 1, H, W, dtype=torch.float16))
+
+
+def test_clip_wave_time_stays_float64_in_float32_clips():
+    """The augmentations hand the wave time to the renderer in float64: a float32 clip at 86 000 s
+    (inside the default draw range's bound) matches the float64 clip to 6e-4 K (2.7e-4 measured;
+    1.4e-3 when the time was cast to float32, found in review)."""
+    out = {}
+    for dtype in (torch.float32, torch.float64):
+        clip = rs.RandomSeaClip(wind_speed=(6.0, 6.0), altitude_m=(10.0, 10.0), pitch_deg=(-8.0, -8.0),
+                                time_s=(86000.0, 86000.0), output="brightness_temperature", foam=False)
+        out[dtype] = clip(torch.zeros(1, 3, 1, 16, 20, dtype=dtype), generator=torch.Generator().manual_seed(0)).double()
+    assert float((out[torch.float32] - out[torch.float64]).abs().max()) < 6e-4
+
+
+# ------------------------------------------------------------------------------------------------
+# Day images
+# ------------------------------------------------------------------------------------------------
+def test_mwir_glint_ahead_is_much_brighter_than_by_night():
+    """MWIR, 5 m/s, camera 20 m up looking 3° down, the sun 10° up straight ahead: the glint raises
+    the brightest pixel by > 10 K over the same draw by night; the sun behind the camera adds no
+    glint (out of view), only the sunlight the aerosol scatters into the sky (its sky pixels and
+    the sea's reflection of it): everywhere >= 0 and under 1 K (0.37 K measured), a tenth of the glint."""
+    kw = dict(wind_speed=5.0, altitude_m=20.0, pitch_deg=-3.0, hfov_deg=20.0, band=rs.MWIR,
+              output="brightness_temperature")
+    x = torch.zeros(2, 1, H, W)
+    night = RandomSeaBackground(**kw)
+    day = RandomSeaBackground(**kw, daytime=1.0, sun_elevation_deg=10.0, sun_azimuth_deg=0.0)
+    behind = RandomSeaBackground(**kw, daytime=1.0, sun_elevation_deg=10.0, sun_azimuth_deg=180.0)
+    yn, yd, yb = night(x, generator=gen(1)), day(x, generator=gen(1)), behind(x, generator=gen(1))
+    assert day._params["is_day"].all()
+    assert torch.equal(day._params["wave_seed"], night._params["wave_seed"])  # the same sea
+    gain = yd.amax(dim=(1, 2, 3)) - yn.amax(dim=(1, 2, 3))
+    assert bool((gain > 10.0).all()), gain
+    assert float((yb - yn).min()) >= -1e-4 and float((yb - yn).max()) < min(1.0, 0.1 * float(gain.min()))
+
+
+def test_day_draws_replay_bit_for_bit():
+    """Still images and clips with day images: params replay the same output bit for bit, and
+    render_parameters of the params is the augmentation's radiance (day and night images batched
+    together)."""
+    x = torch.zeros(4, 1, H, W)
+    aug = RandomSeaBackground(daytime=0.5, band=rs.MWIR, sun_azimuth_deg=(-20.0, 20.0), wind_speed=(3.0, 10.0))
+    y = aug(x, generator=gen(2))
+    p = aug._params
+    assert 0 < int(p["is_day"].sum()) < 4  # both kinds in the batch
+    assert torch.equal(aug(x, params=p), y)
+    assert torch.equal(render_parameters(p, H, W, aug.sampler.atmospheres, band=rs.MWIR), y)
+    clip = RandomSeaClip(daytime=1.0, band=rs.MWIR, sun_elevation_deg=8.0, sun_azimuth_deg=0.0, wind_speed=5.0,
+                         altitude_m=20.0, pitch_deg=-3.0, output="brightness_temperature", frame_rate=10.0,
+                         texture=False)
+    xc = torch.zeros(1, 2, 1, H, W)
+    yc = clip(xc, generator=gen(4))
+    assert torch.equal(clip(xc, params=clip._params), yc)
+    assert float(yc.amax(dim=(2, 3, 4)).min()) > 350.0  # the glint in every frame (the sea is ~290 K)
+
+
+@pytest.mark.parametrize("cls", [RandomSeaBackground, RandomSeaClip])
+def test_composite_mode_refuses_a_gate_that_would_mix_units(cls):
+    """In composite mode an input is a target chip (kelvin and α): a chip left out by p < 1 came back
+    beside sensor counts in one batch (means 305 K and ~7000 counts). p < 1 is refused there, naming
+    p; replace mode keeps kornia's p (an unselected image is the input itself)."""
+    with pytest.raises(ValueError, match=r"^p must be 1 with mode='composite'"):
+        cls(mode="composite", p=0.5)
+    assert cls(mode="composite", p=1.0).p == 1.0
+    assert cls(mode="replace", p=0.5).p == 0.5
+
+
+def test_replace_mode_leaves_unselected_images_as_they_came():
+    aug = RandomSeaBackground(p=0.5, output="brightness_temperature", texture=False)
+    x = torch.full((8, 1, 12, 16), -1.0)
+    y = aug(x, generator=torch.Generator().manual_seed(3))
+    kept = (y == -1.0).flatten(1).all(1)
+    assert 0 < int(kept.sum()) < 8  # some images left out, some rendered
+    assert bool((y[~kept] > 200.0).all())  # the rendered ones are sea temperatures
+

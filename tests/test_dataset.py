@@ -7,12 +7,15 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 import torch
 
+from roughsea_torch import dataset as D
 from roughsea_torch.augmentation import SceneSampler, render_parameters
 from roughsea_torch.dataset import (
     SeaShardDataset,
@@ -217,15 +220,6 @@ def test_day_metadata_reproduces_each_image(tmp_path):
         assert torch.equal(c[0].round(), img)
 
 
-def test_mwir_day_config_resolves():
-    import tomllib
-
-    cfg = resolve_config(tomllib.loads((ROOT / "pipelines" / "configs" / "sea_mwir_day.toml").read_text()))
-    sc = cfg["scene"]
-    assert sc["band"] == "MWIR" and sc["daytime"] > 0 and sc["sun_elevation_deg"] == [3.0, 40.0]
-    assert sc["sun_azimuth_deg"] == [-60.0, 60.0] and sc["sun_azimuth_relative_to_yaw"] is True
-
-
 def test_reader_splits_over_workers_and_converts_to_radiance(reference):
     ds = SeaShardDataset(reference, radiance=True)
     assert len(ds) == 7
@@ -366,3 +360,32 @@ def test_foam_off_in_the_config_reaches_the_shards(tmp_path):
         resolve_config(dict(CFG, scene=dict(CFG["scene"], foam=1.5)))
     with pytest.raises(ValueError, match="scene.foam: one setting for every image"):
         resolve_config(dict(CFG, scene=dict(CFG["scene"], foam=[0.1, 0.2])))
+
+
+def test_frame_render_parameters_docstring_matches_its_result():
+    """The docstring promised an "atmosphere_name" key the result never had."""
+    meta = {name: 1.0 for name, *_r in D.SCENE_FIELDS}
+    meta.update(atmosphere="midlatitude_summer", noise_seed=np.int64(9), wave_seed=np.int64(4), time_s=2.5)
+    p = D.frame_render_parameters(meta)
+    doc = D.frame_render_parameters.__doc__
+    assert "atmosphere" not in p and "atmosphere_name" not in doc
+    assert 'meta["atmosphere"]' in doc
+    for key in set(p) - {name for name, *_r in D.SCENE_FIELDS}:
+        assert f"``{key}``" in doc, key
+
+
+def test_dataset_workers_warnings_point_at_the_callers_line():
+    """A warning raised while a worker process renders a shard (here: the light wind's resolved slopes
+    scaled to Cox–Munk) reaches the caller of generate at the caller's line; it pointed into
+    multiprocessing, in the worker."""
+    from roughsea_torch.dataset import generate
+
+    cfg = {"num_images": 2, "shard_size": 1, "batch_size": 1, "camera": {"height": 12, "width": 16},
+           "scene": {"wind_speed": [0.6, 0.8], "altitude_m": [2.0, 3.0], "pitch_deg": [-60.0, -50.0],
+                     "hfov_deg": [20.0, 30.0], "daytime": 0.0}, "sensor": {}}
+    with tempfile.TemporaryDirectory() as d, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        generate(cfg, d, workers=1, progress=False)
+    scaled = [w for w in caught if "scaled down" in str(w.message)]
+    assert scaled and all(w.filename == __file__ for w in scaled)
+

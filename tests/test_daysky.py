@@ -1,4 +1,5 @@
-"""The solar-scattered daytime sky (roughsea_torch.daysky) and the aerosol-dimmed direct beam.
+"""The solar-scattered daytime sky (roughsea_torch.daysky). (The aerosol-dimmed direct beam:
+tests/test_solar.py.)
 
 Uses only the shipped tables (never LOWTRAN itself). The held-out values were computed by LOWTRAN
 (pipelines/lowtran_daysky.py) at points between the table nodes, from its full-resolution spectra,
@@ -18,6 +19,7 @@ import torch
 
 from roughsea_torch import atmosphere as atm
 from roughsea_torch import daysky, solar
+from roughsea_torch._tables import read_table
 from roughsea_torch.atmosphere import spectral_weights
 from roughsea_torch.radiometry import as_band
 from roughsea_torch.sun import SUN_RADIUS
@@ -36,14 +38,14 @@ CLAIM_SUN_DEG, CORE_DEG, AUREOLE_DEG, FLOOR = 80.0, 20.0, 10.0, 0.01
 
 
 def _table() -> dict:
-    return daysky._read_table(daysky.TABLE, None)
+    return read_table(str(atm.DATA_DIR / daysky.TABLE))
 
 
 T = _table()
 NAMES = [str(n) for n in T["atmospheres"]]
 AEROSOLS = [str(n) for n in T["aerosols"]]
 COMBOS = [(n, a) for n in NAMES for a in AEROSOLS]
-pytestmark = pytest.mark.usefixtures("one_torch_thread")
+pytestmark = pytest.mark.usefixtures("one_thread")
 
 
 _SKIES: dict = {}
@@ -299,45 +301,3 @@ def test_errors():
     sky = sky_of("tropical", "maritime", "mwir")
     with pytest.raises(ValueError, match="cos_view_zenith, relative_azimuth, sun_zenith"):
         sky(torch.tensor([1], dtype=torch.float16), 0.0, 0.0)
-    with pytest.raises(ValueError, match="aerosol"):
-        solar.load_solar_irradiance("tropical", MWIR, aerosol="volcanic")
-
-
-# --------------------------------------------------------------------------------------------------
-# The direct beam with aerosol (solar.load_solar_irradiance(aerosol=...))
-# --------------------------------------------------------------------------------------------------
-
-
-def test_direct_beam_with_aerosol_held_out_values():
-    """LOWTRAN's held-out band irradiance with aerosol: <= 1e-3 up to 85 deg (as without aerosol),
-    <= 2 % closer to the horizon (LOWTRAN's own float32 ray tracing there)."""
-    d = solar._aerosol_table(None)
-    z = torch.tensor(np.array(d["check_sun_zenith_rad"]), dtype=F64)
-    claim = z <= math.radians(85.0) + 1e-12
-    names = [str(b) for b in d["check_band_names"]]
-    for ia, name in enumerate(str(n) for n in d["atmospheres"]):
-        for ib, aer in enumerate(str(n) for n in d["aerosols"]):
-            for band in ("mwir", "lwir"):
-                e = solar.load_solar_irradiance(name, BANDS[band], aerosol=aer)
-                rel = (e(z, horizon=False) / torch.tensor(np.array(d["check_irradiance"][ia, ib, names.index(band)])) - 1).abs()
-                assert float(rel[claim].max()) <= 1e-3 and float(rel[~claim].max()) <= 2e-2, (name, aer, band)
-
-
-def test_aerosol_dims_the_beam_and_default_is_unchanged():
-    for name in ("midlatitude_summer", "subarctic_winter"):
-        z = deg([0.0, 45.0, 75.0, 88.0])
-        for band in BANDS.values():
-            clear = solar.load_solar_irradiance(name, band)
-            t = solar.solar_tables()
-            i = [str(n) for n in t["atmospheres"]].index(name)
-            w = spectral_weights(1e-2 / t["wavenumber_cm1"].astype(np.float64), as_band(band))
-            np.testing.assert_array_equal(clear.node_irradiance, t["direct_irradiance"][i].astype(np.float64) @ w)
-            e0 = clear(z)
-            for aer in AEROSOLS:
-                e1 = solar.load_solar_irradiance(name, band, aerosol=aer)(z)
-                assert bool((e1 < e0).all())
-                # more dimming for a lower sun (longer path through the aerosol)
-                assert bool(((e1 / e0)[1:] < (e1 / e0)[:-1]).all())
-        tau = daysky.direct_aerosol_transmittance(name, "maritime")
-        assert tau.shape == solar.solar_tables()["direct_irradiance"].shape[1:]
-        assert np.all((tau > 0) & (tau <= 1))

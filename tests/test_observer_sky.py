@@ -15,6 +15,8 @@ import torch
 from roughsea_torch import atmosphere as atm
 from roughsea_torch.observer_sky import observer_tables
 
+from conftest import torch_threads
+
 LWIR = (8e-6, 12e-6)
 MWIR = (3e-6, 5e-6)
 BANDS = {"lwir": LWIR, "mwir": MWIR}
@@ -35,7 +37,7 @@ DIP_TABLE = {"subarctic_winter": 2e-2}
 DIP_TABLE_DEFAULT = 4e-3
 
 pytestmark = [pytest.mark.skipif(not NAMES, reason="no observer-sky tables"),
-              pytest.mark.usefixtures("one_torch_thread")]
+              pytest.mark.usefixtures("one_thread")]
 
 
 def sin_dip(h):
@@ -45,7 +47,8 @@ def sin_dip(h):
 
 @pytest.fixture(scope="module")
 def skies():
-    return {(n, b): atm.load_observer_sky(n, band, dtype=F64) for n in NAMES for b, band in BANDS.items()}
+    with torch_threads(1):
+        return {(n, b): atm.load_observer_sky(n, band, dtype=F64) for n in NAMES for b, band in BANDS.items()}
 
 
 def test_all_six_atmospheres_shipped_within_the_size_budget():

@@ -11,13 +11,7 @@ import torch
 
 import roughsea_torch as rs
 
-
-@pytest.fixture
-def two_threads():
-    old = torch.get_num_threads()
-    torch.set_num_threads(2)
-    yield
-    torch.set_num_threads(old)
+from conftest import make_cams, make_scene
 
 
 def _scene(wind):
@@ -26,8 +20,7 @@ def _scene(wind):
 
 
 def _cams():
-    return rs.make_camera(24, 32, altitude_m=torch.tensor([10.0, 20.0, 50.0, 200.0]),
-                          pitch_deg=torch.tensor([-2.0, -4.0, -8.0, -1.0]), dtype=torch.float64)
+    return make_cams(altitude_m=torch.tensor([10.0, 20.0, 50.0, 200.0]), pitch_deg=torch.tensor([-2.0, -4.0, -8.0, -1.0]))
 
 
 def test_images_do_not_depend_on_the_thread_count(two_threads):
@@ -225,8 +218,8 @@ def test_map_chunks_lone_chunk_and_autocast(two_threads):
     with torch.autocast("cpu", dtype=torch.bfloat16):
         on_workers = map_chunks(probe, [0, 1], "cpu")
         assert all(name.startswith("roughsea") and n == 1 and ac for name, n, ac in on_workers)
-        cams = rs.make_camera(24, 32, altitude_m=torch.tensor([10.0, 20.0, 50.0, 200.0]),
-                              pitch_deg=torch.tensor([-2.0, -4.0, -8.0, -1.0]))
+        cams = make_cams(altitude_m=torch.tensor([10.0, 20.0, 50.0, 200.0]), pitch_deg=torch.tensor([-2.0, -4.0, -8.0, -1.0]),
+                         dtype=torch.float32)
         two = rs.render(cams, _scene(torch.tensor([3.0, 6.0, 9.0, 12.0])), chunk=2)
         torch.set_num_threads(1)
         one = rs.render(cams, _scene(torch.tensor([3.0, 6.0, 9.0, 12.0])), chunk=2)
@@ -249,8 +242,8 @@ def test_textured_render_of_two_images_uses_the_workers(two_threads, monkeypatch
         return map_chunks(wrapped, items, device)
 
     monkeypatch.setattr(sys.modules["roughsea_torch.renderer.table"], "map_chunks", spy_map)
-    cams = rs.make_camera(16, 20, altitude_m=20.0, pitch_deg=-6.0, batch_size=2)
-    rs.render(cams, rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, seed=[1, 2]))
+    cams = make_cams(16, 20, pitch_deg=-6.0, batch_size=2, dtype=torch.float32)
+    rs.render(cams, make_scene(seed=[1, 2]))
     assert len(names) >= 2 and all(n.startswith("roughsea") for n in names)
 
 

@@ -42,3 +42,15 @@ def test_readme_block_runs(line, code, monkeypatch):
         error = "".join(traceback.format_exception_only(type(e), e)).strip()
     if error is not None:
         pytest.fail(f"README.md block at line {line} ({first!r}) failed: {error}", pytrace=False)
+
+
+def test_readme_is_a_short_guide_whose_links_exist():
+    """About 250 lines (it was 848, mostly history), no commit hashes, every relative link to a file
+    of the repository."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert text.count("\n") < 300
+    assert not re.findall(r"\b[0-9a-f]{7,40}\b(?=[^`]*?(?:commit|`))", text.split("## Data and licences")[0]), \
+        "commit hashes belong in docs/history.md"
+    for target in re.findall(r"\]\(([^)#:]+)(?:#[^)]*)?\)", text):
+        assert (ROOT / target).exists(), f"README links to {target}, which does not exist"
+

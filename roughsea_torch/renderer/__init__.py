@@ -10,7 +10,8 @@ The user API is what this package exports: :func:`render`, :class:`SeaRenderer`,
 - :mod:`.coordinates` — the spans of view angles an image covers, and a pixel's table coordinates;
 - :mod:`.spectral` — Chebyshev–Lobatto nodes and their resampling to fine tables;
 - the terms: :mod:`.sky_terms` (the sky, the sun's disk, the day sky), :mod:`.path` (the air),
-  :mod:`.foam_terms` (whitecaps), :mod:`.glint` (sun glint), :mod:`.texture` (textured seas);
+  :mod:`.foam_terms` (whitecaps), :mod:`.glint` (sun glint), :mod:`.texture` (textured seas) and
+  :mod:`.hits` (what a pixel sees of the resolved waves near grazing);
 - the methods: :mod:`.table` (the default: nodes → fine tables → one lookup per pixel → per-pixel
   terms; :mod:`.pixels` its in-place fast path) and :mod:`.direct` (every pixel evaluated);
 - :mod:`.api` — :func:`render` and :class:`SeaRenderer`; :mod:`.output` — kelvin.

@@ -15,12 +15,12 @@ import numpy as np
 import torch
 
 from .._validation import check_finite_range, parse_seeds, per_batch
-from ..atmosphere import as_sky, load_observer_sky, load_path, load_sky, surface_air_temperature
+from ..atmosphere import as_sky, available_atmospheres, load_observer_sky, load_path, load_sky, surface_air_temperature
 from ..daysky import AEROSOLS, load_scattered_sky
 from ..foam import whitecap_fraction
 from ..optics import band_index_lookup, split_refractive_index
 from ..radiometry import LWIR, SpectralBand, as_band, band_radiance, brightness_temperature
-from ..slopes import SlopeStatistics
+from ..slopes import MAX_WIND_SPEED, SlopeStatistics
 from ..solar import load_solar_irradiance
 from ..sun import Sun
 from ..waves import MAX_WIND_DIRECTION, WaveField, check_time
@@ -60,7 +60,15 @@ class SceneParameters:
     def batch_size(self) -> int:
         return int(self.vx.shape[0])
 
+
 _CACHE_LOCK = threading.RLock()  # SeaScene's caches (skies, wave fields), filled from worker threads
+
+
+def _check_atmosphere_name(argument: str, name: str) -> None:
+    """``ValueError`` naming the scene's argument (``sky``, ``path``) for an unknown atmosphere."""
+    known = available_atmospheres()
+    if name not in known:
+        raise ValueError(f"{argument}: unknown atmosphere {name!r}; available: {', '.join(known)}")
 
 
 def _cached_one(cache: dict, key: Any, load: Any) -> Any:
@@ -218,7 +226,7 @@ class SeaScene:
         if (sea_temperature is None) == (sea_radiance is None):
             raise ValueError("SeaScene: give exactly one of sea_temperature= or sea_radiance=")
         if wind_speed is not None:
-            check_finite_range("wind_speed", wind_speed, 0.0, 80.0, unit="m/s")
+            check_finite_range("wind_speed", wind_speed, 0.0, MAX_WIND_SPEED, unit="m/s")
             slopes = SlopeStatistics.cox_munk(wind_speed, anisotropic=anisotropic)
         if not isinstance(slopes, SlopeStatistics):
             raise ValueError(f"slopes must be a SlopeStatistics; got {type(slopes).__name__}")
@@ -235,6 +243,7 @@ class SeaScene:
         self.band: SpectralBand = as_band(band, response)
         self.atmosphere = sky if isinstance(sky, str) else None
         if self.atmosphere is not None:  # a shipped LOWTRAN7 atmosphere, integrated over this band
+            _check_atmosphere_name("sky", self.atmosphere)
             sky = load_sky(self.atmosphere, (self.band.lo, self.band.hi), self.band.response, dtype=torch.float64)
         self.sky = as_sky(sky)
         if path is None:
@@ -244,6 +253,7 @@ class SeaScene:
                 raise ValueError("path=True needs a named atmosphere: give sky='<name>' or path='<name>'")
             path = self.atmosphere
         if isinstance(path, str):
+            _check_atmosphere_name("path", path)
             path = load_path(path, (self.band.lo, self.band.hi), self.band.response, dtype=torch.float64)
         if path is not False and not callable(path):
             raise ValueError(f"path must be None, a bool, an atmosphere name or an AtmosphericPath; got {path!r}")
@@ -355,22 +365,36 @@ class SeaScene:
         return _cached_one(self._observer_skies, (self.atmosphere, self.band),
                            lambda: load_observer_sky(self.atmosphere, self.band, dtype=torch.float64))
 
+    def field_sizes(self) -> dict[str, int]:
+        """The batch size each per-image argument gives, by its name (arguments of shape (B,) only;
+        a sequence of seeds gives its length)."""
+        fields = {"wind_speed" if self.wind_speed is not None else "slopes": (
+                      self.slopes.var_upwind, self.slopes.var_crosswind, self.slopes.cov),
+                  "wind_direction": (self.wind_direction,), "sea_temperature": (self.sea_temperature,),
+                  "sea_radiance": (self.sea_radiance,), "air_temperature": (self.air_temperature,),
+                  "time_s": (self.time_s,)}
+        out = {}
+        for name, values in fields.items():
+            for v in values:
+                if isinstance(v, torch.Tensor) and v.ndim > 0:
+                    out[name] = int(v.shape[0])
+        if isinstance(self.seed, list):  # one seed per image: a list of 1 is a batch of 1, not a broadcast
+            out["seed"] = len(self.seed)
+        return out
+
     @property
     def batch_size(self) -> int:
-        sizes = {
-            int(v.shape[0])
-            for v in (
-                self.slopes.var_upwind, self.slopes.var_crosswind, self.slopes.cov, self.wind_direction,
-                self.sea_temperature, self.sea_radiance, self.air_temperature, self.time_s,
-            )
-            if isinstance(v, torch.Tensor) and v.ndim > 0
-        }
-        if isinstance(self.seed, list):  # one seed per image: a list of 1 is a batch of 1, not a broadcast
-            if len(sizes) == 1:
-                self.seeds(next(iter(sizes)))  # ValueError naming seed, B and its length if they differ
-            sizes.add(len(self.seed))
+        """B: the batch size of the per-image arguments (1 when every one is a scalar); a ``ValueError``
+        naming them where they disagree."""
+        by_name = self.field_sizes()
+        others = {v for k, v in by_name.items() if k != "seed"}
+        if "seed" in by_name and len(others) == 1:
+            self.seeds(next(iter(others)))  # ValueError naming seed, B and its length if they differ
+        sizes = set(by_name.values())
         if len(sizes) > 1:
-            raise ValueError(f"SeaScene: fields disagree on the batch size: {sorted(sizes)}")
+            listing = ", ".join(f"{k} has {v}" for k, v in by_name.items())
+            raise ValueError(f"SeaScene: the per-image arguments disagree on the batch size ({listing}); give each "
+                             "one value per image, or a scalar for all")
         return sizes.pop() if sizes else 1
 
     def seeds(self, B: int) -> list[int]:
@@ -412,7 +436,10 @@ class SeaScene:
         """The scene's per-image tensors for a render of B images (:class:`SceneParameters`)."""
         own = self.batch_size
         if own not in (1, B):
-            raise ValueError(f"SeaScene has batch size {own} but the cameras have {B}")
+            names = " and ".join(k for k, v in self.field_sizes().items() if v == own)
+            raise ValueError(f"SeaScene: {names} {'have' if ' and ' in names else 'has'} batch size {own} (one value per "
+                             f"image) but the cameras have {B} images; give one value per camera"
+                             + (", or one int seed (seeds are then derived per image)" if "seed" in names else ""))
         if isinstance(self.seed, list):
             self.seeds(B)  # exactly B seeds, checked before any work
         vx, vy, cxy = (per_batch("slopes", v, B, dtype, device) for v in self.slopes.tensors(dtype, device))

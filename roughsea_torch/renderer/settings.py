@@ -76,6 +76,19 @@ class TableSize:
         texture_min_band_share: per image, the octaves of the wave field that carry less than this
             share of its slope variance (and of its crest variable's) are left out of the
             realization, their variance left to the unresolved statistics; 0 keeps every band.
+        texture_hit: where a pixel meets the resolved waves. ``"first"``: where its ray
+            first meets the resolved surface (:mod:`~roughsea_torch.renderer.hits`: a crest hides the
+            trough behind it, facets turned away are never seen), the resolved slope there as it is.
+            ``"flat"`` (default): at its flat-sea point, the resolved slope's quantile mapped onto the
+            visible-slope distribution (:func:`~roughsea_torch.clutter.visible_slope`; its ensemble
+            mean is the expectation image exactly, but near grazing it has neither parallax nor
+            hiding). The table method's setting; ``method="direct"`` evaluates the flat point per pixel.
+        texture_hit_step, texture_hit_min_step, texture_hit_across, texture_hit_tracks: the sweep of
+            ``texture_hit="first"``: its samples' spacing in depression [pixels], ``across`` · cos θ̂/2
+            clamped into [``min_step``, ``step``] (each sample filtered at twice its spacing's footprint
+            along the view: near grazing the waves down to ``across`` times the pixel's width across
+            the view; :func:`~roughsea_torch.renderer.hits.sample_step`), and its ground tracks per
+            pixel width.
 
     For accuracy finer than the defaults, e.g. MWIR day skies about the sun:
     ``TableSize(texture_quadrature=(20, 16), texture_azimuth_sun=17, fine_texture_azimuth=64)``.
@@ -102,6 +115,11 @@ class TableSize:
     texture_steep_zenith_deg: float = 40.0
     texture_quadrature_width: float = 4.5
     texture_min_band_share: float = 1e-8
+    texture_hit: str = "flat"
+    texture_hit_step: float = 0.25
+    texture_hit_min_step: float = 0.03125
+    texture_hit_across: float = 1.0
+    texture_hit_tracks: float = 1.0
     texture_azimuth_sun: int = 9
     zenith_narrow: int = 21
     azimuth_day: int = 25
@@ -111,6 +129,8 @@ class TableSize:
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):
             raise ValueError(f"TableSize.span must be 'pixels' or 'full'; got {self.span!r}")
+        if self.texture_hit not in ("first", "flat"):
+            raise ValueError(f"TableSize.texture_hit must be 'first' or 'flat'; got {self.texture_hit!r}")
         for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin", "zenith_narrow", "azimuth_day", "texture",
                      "texture_zenith", "texture_zenith_sun", "texture_azimuth_sun", "glint"):
             if int(getattr(self, name)) < 2:
@@ -126,7 +146,9 @@ class TableSize:
                                for v in rule)):
                 raise ValueError(f"TableSize.{name} must be (outer, inner), two ints in [1, 512]; got {rule!r}")
             object.__setattr__(self, name, tuple(int(v) for v in rule))  # hashable (tables are cached by it)
-        for name, lo, hi in (("texture_steep_zenith_deg", 0.0, 90.0), ("texture_quadrature_width", 1.0, 40.0)):
+        for name, lo, hi in (("texture_steep_zenith_deg", 0.0, 90.0), ("texture_quadrature_width", 1.0, 40.0),
+                             ("texture_hit_step", 0.01, 1.0), ("texture_hit_min_step", 0.001, 1.0),
+                             ("texture_hit_across", 0.1, 100.0), ("texture_hit_tracks", 0.25, 16.0)):
             v = getattr(self, name)
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real) or not lo <= float(v) <= hi:
                 raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")

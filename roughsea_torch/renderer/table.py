@@ -40,7 +40,6 @@ import torch.nn.functional as F
 
 from .._parallel import map_chunks
 from ..expectation import reflection_terms
-from ..foam import crest_fraction_from_variances
 from ..sky import select_sky
 from ..slopes import SlopeStatistics
 from .coordinates import (ViewSpans, angle_of_ratio, asinh_fast, azimuth_coordinate, azimuth_ratio, camera_spans,
@@ -130,7 +129,7 @@ def render_chunk(plan: RenderPlan, nd: NodeValues, sl: slice) -> torch.Tensor:
         return fast
     rays = pixel_rays(plan, maps, sl)
     vals, second = lookup(plan, ft, maps, rays)
-    return per_pixel_terms(plan, ft, rays, vals, second, sl)
+    return per_pixel_terms(plan, ft, maps, rays, vals, second, sl)
 
 
 # ---- stage 1: spans, nodes, the model at the nodes ---------------------------------------------
@@ -226,8 +225,8 @@ class FineTable:
     (``lo``, ``span_z``) and the azimuth span (``az_lo``, ``az_hi``: of the ratio u or the angle o;
     ``a``, ``b``: of the angle); the sky rows' first cosine ``s0`` and step ``ds``; whether any pixel
     sees sky; the path's τ per sea row (or None); whether channel 1 is the crest foam (``crest``) and
-    which images' glint the table holds (``glint_tab`` (b,) bool, or None); the texture volume and
-    wave field of a textured chunk (or None)."""
+    which images' glint the table holds (``glint_tab`` (b,) bool, or None); the texture volume of a
+    textured chunk (or None)."""
 
     fine: torch.Tensor
     spans: ViewSpans
@@ -244,7 +243,6 @@ class FineTable:
     crest: bool
     glint_tab: torch.Tensor | None
     texture: torch.Tensor | None
-    field: Any
 
 
 def fine_table(plan: RenderPlan, nd: NodeValues, sl: slice) -> FineTable:
@@ -252,9 +250,8 @@ def fine_table(plan: RenderPlan, nd: NodeValues, sl: slice) -> FineTable:
     at ζ = lo + span (y_z + 1)/2, sky rows at cos = s0 + j ds (a ray at the horizontal, cos = 0, where a
     sea-level sky is held constant below, a kink, falls on a row); row r is read at
     gy = 2 r / (N − 1) − 1."""
-    delta = field = None
+    delta = None
     if plan.textured and bool(nd.active.any()):  # the fine texture volume of the chunk (None: nothing resolved)
-        field = plan.texture.field(sl)
         delta = plan.texture.volume(nd.delta, sl, nd.lo, nd.span_z)
     # textured seas put their whitecaps on the crests, a fraction f_pix per pixel: the fine table
     # then carries the foam-free sea and the foam as two channels, mixed per pixel
@@ -288,7 +285,7 @@ def fine_table(plan: RenderPlan, nd: NodeValues, sl: slice) -> FineTable:
     else:
         fine = fine[:, None]
     return FineTable(fine, nd.spans, nd.lo, nd.span_z, nd.a, nd.b, az_lo, az_hi, s0, ds, has_sky, tau, crest, glint_tab,
-                     delta, field)
+                     delta)
 
 
 def sea_rows_of(plan: RenderPlan, nd: NodeValues, sl: slice, crest: bool) -> tuple[torch.Tensor, Any, Any]:
@@ -507,8 +504,8 @@ def lookup(plan: RenderPlan, ft: FineTable, maps: TableMaps, rays: PixelRays) ->
 # ---- stage 4: what the table cannot hold -----------------------------------------------------------
 
 
-def per_pixel_terms(plan: RenderPlan, ft: FineTable, rays: PixelRays, vals: torch.Tensor, second: torch.Tensor | None,
-                    sl: slice) -> torch.Tensor:
+def per_pixel_terms(plan: RenderPlan, ft: FineTable, maps: TableMaps, rays: PixelRays, vals: torch.Tensor,
+                    second: torch.Tensor | None, sl: slice) -> torch.Tensor:
     """The pixels' values (b, H, W) from the lookup's: plus the scattered day sky of sky pixels, the
     texture, the glint (the table's smooth factor times its sharp factor per pixel, or wholly per
     pixel), mixed with the foam on crests, plus the sun's disk; in kelvin where radiances were added
@@ -522,12 +519,15 @@ def per_pixel_terms(plan: RenderPlan, ft: FineTable, rays: PixelRays, vals: torc
         at = lambda t: t.reshape(-1).index_select(0, flat)  # noqa: E731
         v = day_sky_pixels(plan.day, sl, at(cos), at(dx), at(dy), torch.div(flat, plan.H * plan.W, rounding_mode="floor"))
         vals = vals.reshape(-1).index_add(0, flat, v).reshape(vals.shape)
-    resolved = cos_t = crest_var = None
+    resolved = cos_t = f_pix = None
     if plan.textured or plan.sunny:  # cos θ̂ of the sea pixels, from q (these scenes need the cameras)
         cos_t = plan.eps[sl, None, None].to(dtype) * torch.sqrt(rays.q)
     if plan.textured and ft.texture is not None:  # (textured: always the angle coordinate, az)
-        texture, x_pix, cov_pix, *crest_var = plan.texture.pixels(sl, ft.field, ft.texture, cos_t, rays.zeta, rays.az, dx,
-                                                                  dy, sea, ft.lo, ft.span_z, ft.a, ft.b, crest=ft.crest)
+        def coordinate(ddx: torch.Tensor, ddy: torch.Tensor, i: int) -> torch.Tensor:  # of image i's directions
+            return azimuth_coordinate(ddx, ddy, maps.offset[i:i + 1], plan.fold, plan.period)
+
+        texture, x_pix, cov_pix, f_pix = plan.texture.pixels(sl, ft.texture, cos_t, rays.zeta, rays.az, cos, dx, dy, sea,
+                                                             ft.lo, ft.span_z, ft.a, ft.b, coordinate, crest=ft.crest)
         vals = vals + texture
         resolved = (x_pix, cov_pix)
     if r_vals is not None:
@@ -535,8 +535,6 @@ def per_pixel_terms(plan: RenderPlan, ft: FineTable, rays: PixelRays, vals: torc
     if plan.sunny and (ft.glint_tab is None or not bool(ft.glint_tab.all())):  # the rest per pixel
         vals = vals + pixel_glint(plan, ft, rays, cos_t, resolved, sl)
     if ft.crest:  # (1 − f_pix) · (sea + texture + glint) + f_pix · foam
-        x_r, v_r, v_t = crest_var[0]
-        f_pix = crest_fraction_from_variances(x_r, v_r, v_t, p.foam[sl].to(dtype)[:, None, None])
         # no foam in the sky: there f_pix would be W, and the lerp would take that share of the
         # sky pixels from the foam channel's sky rows, which lack the day's scattered sky
         # (added to the sky pixels of channel 0 above)

@@ -22,10 +22,12 @@ import torch.nn.functional as F
 
 from .._validation import per_batch
 from ..clutter import along_view, footprint, reconcile_scale, resolved_quantile, two_scale_statistics
+from ..foam import crest_fraction_from_variances
 from ..expectation import reflection_terms
 from ..geometry import slant_range
 from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
+from .hits import Sweep, centre_element, pixel_windows, sample_step, sweep_envelope, sweep_layout, visible_average
 from .path import path_rows
 from .scene import SceneParameters
 from .sky_terms import sky_per_image
@@ -81,7 +83,18 @@ class TextureTable:
         self.steep_cos = math.cos(math.radians(float(table.texture_steep_zenith_deg)))
         self.window = float(table.texture_quadrature_width)
         self.min_band_share = float(table.texture_min_band_share)
+        self.first_hit = table.texture_hit == "first"
+        # the sweep (TableSize.texture_hit_*): samples s(θ̂) pixels apart in depression, each filtered at
+        # twice its spacing's footprint along the view, and the volume built for those footprints
+        self.hit_steps = dict(step=float(table.texture_hit_step), min_step=float(table.texture_hit_min_step),
+                              across=float(table.texture_hit_across))
+        self.hit_tracks = float(table.texture_hit_tracks)
         self.scaled = False  # whether some resolved slopes were scaled down (reconcile_scale)
+
+    def _scale(self, cos_view: torch.Tensor) -> Any:
+        """The footprint of the texture's nodes, in whole pixels' along-view footprints: 1, or with the
+        sweep twice its sample spacing at that view (:func:`~roughsea_torch.renderer.hits.sample_step`)."""
+        return 2.0 * sample_step(cos_view, **self.hit_steps) if self.first_hit else 1.0
 
     def field(self, sl: slice) -> Any:
         """The wave field of images ``sl``."""
@@ -141,7 +154,7 @@ class TextureTable:
         th_nodes = torch.acos((self.eps[sl][:, None] * torch.sinh(zeta)).clamp(0.0, 1.0)).to(dtype)
         h = self.altitude[sl].to(dtype)
         cos_n = torch.cos(th_nodes)
-        L = footprint(slant_range(cos_n, h[:, None], self.earth_radius_m), cos_n, self.ifov[sl, None])
+        L = footprint(slant_range(cos_n, h[:, None], self.earth_radius_m), cos_n, self.ifov[sl, None] * self._scale(cos_n))
         cov, _ = self.resolved(wf, L, sl)
         cov = tuple(c[:, :, None] for c in cov)  # (b, nz, 1)
         phw = ph_nodes + p.wind_direction[sl, None].to(dtype)  # LOS azimuth in the world
@@ -158,8 +171,11 @@ class TextureTable:
         va_, kp_ = full(var_a), full(kap)
         ct = full(cos_n[:, :, None])
         ph = full(ph_nodes[:, None, :])
-        shifted, x_vis = two_scale_statistics(vx[img, 0, 0], vy[img, 0, 0], cxy[img, 0, 0], ph, ct,
-                                              self.xnodes.expand(img.numel(), -1), va_, kp_, return_visible=True)  # (M, nx)
+        # the resolved slope a pixel sees: at its ray's first hit as it is (the hits weight the facets),
+        # or at its flat-sea point mapped onto the visible-slope distribution
+        x = self.xnodes.expand(img.numel(), -1)
+        shifted, x_vis = two_scale_statistics(vx[img, 0, 0], vy[img, 0, 0], cxy[img, 0, 0], ph, ct, x, va_, kp_,
+                                              visible=x if self.first_hit else None, return_visible=True)  # (M, nx)
         # one more column, the expectation itself (nothing resolved), on the same quadrature: Δ is
         # the difference of two evaluations whose quadrature errors nearly cancel, so the texture
         # nodes can take a coarser rule than the mean table (TableSize.texture_quadrature)
@@ -228,19 +244,22 @@ class TextureTable:
                 vol[:, :1] *= t_
         return vol.flatten(-2)
 
-    def pixels(self, sl: slice, wf: Any, vol: torch.Tensor, cos_t: torch.Tensor, zeta: torch.Tensor, o: torch.Tensor,
-               dx: torch.Tensor, dy: torch.Tensor, sea: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor,
-               a: torch.Tensor, b: torch.Tensor, crest: bool = False) -> tuple:
-        """The texture of every pixel of images ``sl`` (0 off the sea), (b, H, W); and each pixel's
-        flat-point quantile x and resolved covariance (world frame), for the glint.
+    def pixels(self, sl: slice, vol: torch.Tensor, cos_t: torch.Tensor, zeta: torch.Tensor, o: torch.Tensor,
+               dz: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, sea: torch.Tensor, lo: torch.Tensor,
+               span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any, crest: bool = False) -> tuple:
+        """The texture of every pixel of images ``sl`` (0 off the sea), (b, H, W); each pixel's resolved
+        quantile x and resolved covariance (world frame), for the glint; and with ``crest`` its foam
+        fraction f_pix (:func:`~roughsea_torch.foam.crest_foam_fraction`, 0 off the sea), else None.
 
         Pixels: cos θ̂ ``cos_t``, ζ ``zeta`` and the azimuth coordinate ``o`` (the angle, over the
-        span [a, b]) of their line of sight, the ray's world components ``dx``, ``dy``, the sea mask.
-        With ``crest=True`` a fourth element (X_r, σ_r², σ_X²) for the foam on crests
-        (:func:`~roughsea_torch.foam.crest_foam_fraction`): the pixel's resolved crest variable
-        X_r (b, H, W), sampled in the same pass over the bands as the slopes (one more channel), its
-        variance σ_r² (b, H, W) at the pixel's footprint (tabulated on the texture's rows like the
-        covariance) and the field's total σ_X² (b, 1, 1); X_r = σ_r² = 0 off the sea (f_pix = W there)."""
+        span [a, b]) of their line of sight, the ray's components along the camera's vertical ``dz``
+        and world x, y ``dx``, ``dy``, the sea mask; ``coordinate(dx, dy, i)`` the azimuth coordinate
+        of world directions for image i of the chunk. With ``TableSize.texture_hit="first"`` a pixel
+        sees the visible surface of its depression window along its ground track
+        (:mod:`~roughsea_torch.renderer.hits`); with ``"flat"`` its flat-sea point."""
+        if self.first_hit:
+            return self._pixels_swept(sl, vol, dz, dx, dy, sea, lo, span_z, a, b, coordinate, crest)
+        wf = self.field(sl)
         dtype = self.dtype
         h = self.altitude[sl].to(dtype)[:, None, None]
         R = slant_range(cos_t, h, self.earth_radius_m)
@@ -255,15 +274,80 @@ class TextureTable:
         x = resolved_quantile(smp["slope_x"], smp["slope_y"], (cov[:, 0], cov[:, 1], cov[:, 2]), dx, dy)
         read = self._read_volume(vol, x, o, gy, a, b)
         out = read[:, 0]
-        # x (or, with a sun, the visible quantile x' read from channel 1) and the resolved covariance go
-        # back too: the glint of the same realization needs them
-        result = (torch.where(sea, out, torch.zeros_like(out)), x if vol.shape[1] == 1 else (x, read[:, 1]),
-                  (cov[:, 0], cov[:, 1], cov[:, 2]))
+        f_pix = None
         if crest:
             zero = torch.zeros_like(out)
-            result = result + ((torch.where(sea, smp["crest"], zero), torch.where(sea, cov[:, 3], zero),
-                                wf.crest_variance()[:, None, None]),)
-        return result
+            f_pix = crest_fraction_from_variances(torch.where(sea, smp["crest"], zero), torch.where(sea, cov[:, 3], zero),
+                                                  wf.crest_variance()[:, None, None],
+                                                  self.p.foam[sl].to(dtype)[:, None, None])
+            f_pix = torch.where(sea, f_pix, zero)
+        # x (or, with a sun, the visible quantile x' read from channel 1) and the resolved covariance go
+        # back too: the glint of the same realization needs them
+        return (torch.where(sea, out, torch.zeros_like(out)), x if vol.shape[1] == 1 else (x, read[:, 1]),
+                (cov[:, 0], cov[:, 1], cov[:, 2]), f_pix)
+
+    def _pixels_swept(self, sl: slice, vol: torch.Tensor, dz: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor,
+                      sea: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor,
+                      coordinate: Any, crest: bool) -> tuple:
+        """:meth:`pixels` by the sweep: per image, the resolved surface along ground tracks, the texture
+        and foam fraction at each sample, each pixel's angular average over the visible surface of its
+        window; for the glint, x and the covariance at its centre ray's first hit."""
+        zero = torch.zeros_like(dz)
+        texture, x_c, f_pix = zero.clone(), zero.clone(), zero.clone() if crest else None
+        cov_c = [zero.clone() for _ in range(3)]
+        for i in range(dz.shape[0]):
+            s = sea[i]
+            if not bool(s.any()):
+                continue
+            rho = torch.sqrt(dx[i] * dx[i] + dy[i] * dy[i]).clamp_min(1e-30)
+            tan_g, phi = (-dz[i] / rho)[s], torch.atan2(dy[i], dx[i])[s]
+            im = sl.start + i
+            wf = self.field(slice(im, im + 1))
+            sw = sweep_layout(wf, 0, self.centres[im], self.altitude[im], tan_g, phi, float(self.ifov[im]),
+                              self.earth_radius_m, tracks=self.hit_tracks, **self.hit_steps)
+            if sw is None:
+                continue
+            values, x_k, cov_k, m = self._swept_samples(im, i, wf, sw, vol, lo, span_z, a, b, coordinate, crest)
+            j = ((phi.detach() - sw.p0) / sw.dphi).round().clamp(0, sw.az.shape[0] - 1).long()
+            tau_t, tau_b = pixel_windows(tan_g, float(self.ifov[im]))
+            avg = visible_average(m, values, j, tau_t, tau_b)
+            texture[i] = texture[i].index_put((s,), avg[0])
+            if crest:
+                f_pix[i] = f_pix[i].index_put((s,), avg[1])
+            k, hit = centre_element(m, j, tan_g)
+            x_c[i] = x_c[i].index_put((s,), torch.where(hit, x_k.T[j, k], torch.zeros_like(tan_g)))
+            for c in range(3):
+                cov_c[c][i] = cov_c[c][i].index_put((s,), cov_k[c][k])
+        return texture, (x_c, x_c), tuple(cov_c), f_pix
+
+    def _swept_samples(self, im: int, i: int, wf: Any, sw: Sweep, vol: torch.Tensor, lo: torch.Tensor,
+                       span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any, crest: bool) -> tuple:
+        """At the sweep's samples of image ``im`` (chunk index ``i``): the texture and foam fraction
+        (C, nt, ns), the resolved quantiles x (ns, nt), the resolved covariance (3 of (ns,)) and the
+        running minimum m (nt, ns) of the envelope."""
+        dtype = self.dtype
+        ns, nt = sw.shape
+        fp = sw.footprint[:, None].expand(ns, nt).reshape(1, -1)
+        smp = wf.sample_unchecked(sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1], fp, elevation=True,
+                                  crest=crest)
+        t, m = sweep_envelope(sw, smp["elevation"][0].reshape(ns, nt))
+        cov = wf.resolved_covariance(sw.footprint[None])  # 3 of (1, ns)
+        cov_k = tuple(c[0] for c in cov)
+        cx, sx = torch.cos(sw.az), torch.sin(sw.az)  # the tracks' ray directions (camera → sea)
+        x_k = resolved_quantile(smp["slope_x"][0].reshape(ns, nt), smp["slope_y"][0].reshape(ns, nt),
+                                tuple(c[:, None] for c in cov_k), cx[None, :], sx[None, :])
+        # each sample's row in the volume: ζ of its flat view zenith (the local vertical tilts by r/R)
+        t0 = sw.flat_depression()
+        cos_k = torch.sin(torch.atan(t0) + 2.0 * sw.curv * sw.r).clamp(1e-9, 1.0)
+        zeta_k = torch.asinh(cos_k.double() / self.eps[im]).to(dtype)
+        gy = ((2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez))[:, None].expand(ns, nt)
+        o = coordinate(cx[None, None, :], sx[None, None, :], i)[0].expand(ns, nt)
+        values = [self._read_volume(vol[i:i + 1], x_k[None], o[None], gy[None], a[i:i + 1], b[i:i + 1])[0, 0]]
+        if crest:
+            var_r = wf.crest_variance(sw.footprint[None])[0][:, None]
+            values.append(crest_fraction_from_variances(smp["crest"][0].reshape(ns, nt), var_r, wf.crest_variance()[0],
+                                                        self.p.foam[im].to(dtype)))
+        return torch.stack([v.T for v in values]), x_k, cov_k, m
 
     def _row_statistics(self, sl: slice, wf: Any, gy: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor,
                         h: torch.Tensor, crest: bool) -> torch.Tensor:
