@@ -21,6 +21,7 @@ with its diff line and a note (the notes live in ``NOTES`` below, keyed by modul
     python pipelines/mutation.py --modules renderer --max-per-module 8          # every renderer/ module
     python pipelines/mutation.py --modules all --max-per-module 8               # every module (hours)
     python pipelines/mutation.py --modules sun --max-per-module 12 --only-survivors
+    python pipelines/mutation.py --modules sampling --only-survivors --match "sample\\(\\)"  # those of one function
     python pipelines/mutation.py --list --modules expectation        # show the mutants only
 """
 
@@ -618,6 +619,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--timeout-factor", type=float, default=4.0, help="timeout per mutant = factor × baseline run time (≥ 300 s)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--only-survivors", action="store_true", help="re-run only the survivors (and timeouts) recorded in the report (same --max-per-module and --seed)")
+    ap.add_argument("--match", help="run only the mutants whose 'function() original → mutated' matches this regular expression")
     ap.add_argument("--list", action="store_true", help="print the mutants and exit")
     ap.add_argument("--report-only", action="store_true", help="rewrite the report from its recorded state and exit")
     ap.add_argument("--json", type=Path, default=ROOT / "docs" / "mutation.json", help=argparse.SUPPRESS)  # legacy state file
@@ -643,13 +645,25 @@ def main(argv: list[str] | None = None) -> int:
         del results[m]  # a module that no longer exists (e.g. render, _pixels before the renderer package)
 
     def make_plan(root: Path) -> dict:
-        plan = {m: mutants_of(m, args.max_per_module, args.seed, root) for m in modules}
-        if args.only_survivors:  # the same sample (same seed), restricted to the recorded survivors
+        # with --only-survivors every candidate is generated, then restricted to the recorded survivors
+        # (a module edited since its run samples differently: its survivors are found all the same)
+        n_max = 10**9 if args.only_survivors else args.max_per_module
+        plan = {m: mutants_of(m, n_max, args.seed, root) for m in modules}
+        if args.only_survivors:
             for m, (muts, src) in plan.items():
                 # matched by function and text, not line: the file may have moved since
-                old = {(x["function"], x["original"], x["mutated"]) for x in results.get(m, {}).get("mutants", [])
-                       if x["status"] in ("survived", "timeout")}
-                plan[m] = ([x for x in muts if (x.function, x.original, x.mutated) in old], src)
+                # (the same text at several lines of a function: the one nearest the recorded line)
+                keep = set()
+                for x in results.get(m, {}).get("mutants", []):
+                    if x["status"] in ("survived", "timeout"):
+                        same = [y for y in muts if (y.function, y.original, y.mutated) == (x["function"], x["original"], x["mutated"])]
+                        if same:
+                            keep.add(min(same, key=lambda y: abs(y.line - x["line"])).index)
+                plan[m] = ([x for x in muts if x.index in keep], src)
+        if args.match:  # e.g. the survivors a new test is meant to kill
+            rx = re.compile(args.match)
+            for m, (muts, src) in plan.items():
+                plan[m] = ([x for x in muts if rx.search(f"{x.function}() {x.original} → {x.mutated}")], src)
         return plan
 
     if args.report_only:

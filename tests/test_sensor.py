@@ -257,3 +257,12 @@ def test_typical_lwir_fixed_pattern_at_the_calibration_point():
     cols = t.mean(0)
     assert abs(float(cols.std()) / 0.05 - 1) < 0.1
     assert abs(float((t - cols).std()) / 0.1 - 1) < 3e-3
+
+
+def test_to_display_over_the_full_range_is_the_min_max_stretch():
+    """low_percentile = 0 and high_percentile = 100 (the documented ends of their range) are the
+    image's minimum and maximum: the stretch is round(255 (x − min)/(max − min)) per image, the
+    minimum at 0 and the maximum at 255."""
+    x = torch.rand(2, 1, 9, 11, generator=gen(4), dtype=torch.float64) * torch.tensor([1.0, 30.0]).view(2, 1, 1, 1)
+    lo, hi = x.amin((1, 2, 3), keepdim=True), x.amax((1, 2, 3), keepdim=True)
+    torch.testing.assert_close(to_display(x, 0.0, 100.0), torch.round(255.0 * (x - lo) / (hi - lo)), rtol=0, atol=0)
