@@ -1,5 +1,5 @@
 """Statistics of textured seas: ensemble-mean bias against view zenith, clutter against range and
-wind, and how fast the clutter decorrelates in time.
+wind, and foam against the sea.
 
 1. **Ensemble mean.** ``--realizations`` independent seeds of a narrow camera 10 m above the sea
    looking 67–90° from the zenith (wind 8 m/s, analytic sky, no path), float64; per row of view
@@ -13,12 +13,9 @@ wind, and how fast the clutter decorrelates in time.
    (``foam=0``: the waves' slopes alone).
 3. **Foam against the sea.** The brightness temperature of a sea without foam and of one wholly
    under foam at view zeniths of 60–88° (LWIR, midlatitude summer, 6 and 12 m/s).
-4. **Time.** A 4 s clip at 25 Hz of one realization: the correlation of the clutter (frame minus
-   expectation) between frames against the lag, and its 1/e time, beside Schwering's (1991)
-   measurement of marine LWIR backgrounds ("time constants of about 1 second for the images in
-   the sequence to become uncorrelated", Proc. SPIE 1486, doi:10.1117/12.45749).
+Time (the clutter's decorrelation against wind and range): ``pipelines/clutter_time.py``.
 
-Writes ``--out``/clutter_statistics.md and three PNGs.
+Writes ``--out``/clutter_statistics.md and two PNGs.
 
 Usage:
     python pipelines/clutter_statistics.py [--realizations 2048] [--out docs]
@@ -112,23 +109,6 @@ def foam_against_sea(winds=(6.0, 12.0), pitches=(-30.0, -15.0, -5.0, -2.0)):
     return rows
 
 
-def decorrelation(fps=25.0, seconds=4.0, wind=8.0):
-    H, W = 128, 160
-    cams = rs.make_camera(H, W, hfov_deg=20.0, altitude_m=20.0, pitch_deg=-4.0)
-    mean = rs.render(cams, rs.SeaScene(wind_speed=wind, sea_temperature=290.0), output="brightness_temperature")
-    times = torch.arange(int(fps * seconds)) / fps
-    clip = rs.render_clip(cams, rs.SeaScene(wind_speed=wind, sea_temperature=290.0, seed=[3]), times,
-                          output="brightness_temperature", progress=True)[0, :, 0]
-    sea = rs.view_geometry(cams).is_sea[0]
-    d = (clip - mean[0, 0])[:, sea]
-    d = d - d.mean(1, keepdim=True)
-    corr = torch.stack([(d[: len(d) - k] * d[k:]).sum(1).mean() / (d * d).sum(1).mean() for k in range(len(d) // 2)])
-    lags = torch.arange(len(corr)) / fps
-    below = (corr < math.exp(-1)).nonzero()
-    t_e = float(lags[below[0, 0]]) if below.numel() else float("nan")
-    return lags, corr, t_e
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--realizations", type=int, default=2048)
@@ -193,17 +173,8 @@ def main() -> None:
               "| wind [m/s] | view zenith [deg] | sea [K] | foam [K] |", "|---:|---:|---:|---:|"]
     lines += [f"| {w:g} | {z:.1f} | {a:.2f} | {b:.2f} |" for w, z, a, b in foam_against_sea()]
 
-    lags, corr, t_e = decorrelation()
-    lines += ["", "## Temporal decorrelation (25 Hz, wind 8 m/s, 20 m, 128×160 over 20°)", "",
-              f"Clutter correlation falls to 1/e after {t_e:.2f} s; Schwering (1991) measured about 1 s for marine "
-              "LWIR image sequences to become uncorrelated (sea states 0–6, coastal and open sea).", ""]
-    fig, ax = plt.subplots(figsize=(5, 3.2))
-    ax.plot(lags, corr)
-    ax.axhline(math.exp(-1), color="0.5", ls=":")
-    ax.set_xlabel("lag [s]")
-    ax.set_ylabel("clutter correlation")
-    fig.tight_layout()
-    fig.savefig(out / "clutter_time.png", dpi=120)
+    lines += ["", "How fast the clutter decorrelates in time, against wind and range: `pipelines/clutter_time.py` "
+              "(docs/clutter_time.md).", ""]
     report = "\n".join(lines) + "\n"
     (out / "clutter_statistics.md").write_text(report)
     print(report)

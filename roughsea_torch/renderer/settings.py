@@ -89,6 +89,11 @@ class TableSize:
             along the view: near grazing the waves down to ``across`` times the pixel's width across
             the view; :func:`~roughsea_torch.renderer.hits.sample_step`), and its ground tracks per
             pixel width.
+        texture_antialias: True (default): the flat-point texture and crest-foam fraction are
+            low-pass filtered along the image's columns, with a zero at the rows' Nyquist frequency
+            (:mod:`~roughsea_torch.renderer.antialias`: the resolved band there would fold into
+            one-pixel horizontal lines; the ensemble mean is unchanged); False: unfiltered. Both
+            methods; the sweep is not filtered.
 
     For accuracy finer than the defaults, e.g. MWIR day skies about the sun:
     ``TableSize(texture_quadrature=(20, 16), texture_azimuth_sun=17, fine_texture_azimuth=64)``.
@@ -116,6 +121,7 @@ class TableSize:
     texture_quadrature_width: float = 4.5
     texture_min_band_share: float = 1e-8
     texture_hit: str = "flat"
+    texture_antialias: bool = True
     texture_hit_step: float = 0.25
     texture_hit_min_step: float = 0.03125
     texture_hit_across: float = 1.0
@@ -131,6 +137,8 @@ class TableSize:
             raise ValueError(f"TableSize.span must be 'pixels' or 'full'; got {self.span!r}")
         if self.texture_hit not in ("first", "flat"):
             raise ValueError(f"TableSize.texture_hit must be 'first' or 'flat'; got {self.texture_hit!r}")
+        if not isinstance(self.texture_antialias, (bool, np.bool_)):
+            raise ValueError(f"TableSize.texture_antialias must be True or False; got {self.texture_antialias!r}")
         for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin", "zenith_narrow", "azimuth_day", "texture",
                      "texture_zenith", "texture_zenith_sun", "texture_azimuth_sun", "glint"):
             if int(getattr(self, name)) < 2:

@@ -27,6 +27,7 @@ from ..expectation import reflection_terms
 from ..geometry import slant_range
 from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
+from .antialias import antialias_texture
 from .hits import Sweep, centre_element, pixel_windows, sample_step, sweep_envelope, sweep_layout, visible_average
 from .path import path_rows
 from .scene import SceneParameters
@@ -84,6 +85,7 @@ class TextureTable:
         self.window = float(table.texture_quadrature_width)
         self.min_band_share = float(table.texture_min_band_share)
         self.first_hit = table.texture_hit == "first"
+        self.antialias = bool(table.texture_antialias)  # (renderer.antialias; the sweep is not filtered)
         # the sweep (TableSize.texture_hit_*): samples s(θ̂) pixels apart in depression, each filtered at
         # twice its spacing's footprint along the view, and the volume built for those footprints
         self.hit_steps = dict(step=float(table.texture_hit_step), min_step=float(table.texture_hit_min_step),
@@ -281,9 +283,12 @@ class TextureTable:
                                                   wf.crest_variance()[:, None, None],
                                                   self.p.foam[sl].to(dtype)[:, None, None])
             f_pix = torch.where(sea, f_pix, zero)
+        out = torch.where(sea, out, torch.zeros_like(out))
+        if self.antialias:  # the band at the rows' Nyquist folds into one-pixel lines (renderer.antialias)
+            out, f_pix = antialias_texture(out, f_pix, sea)
         # x (or, with a sun, the visible quantile x' read from channel 1) and the resolved covariance go
         # back too: the glint of the same realization needs them
-        return (torch.where(sea, out, torch.zeros_like(out)), x if vol.shape[1] == 1 else (x, read[:, 1]),
+        return (out, x if vol.shape[1] == 1 else (x, read[:, 1]),
                 (cov[:, 0], cov[:, 1], cov[:, 2]), f_pix)
 
     def _pixels_swept(self, sl: slice, vol: torch.Tensor, dz: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor,
