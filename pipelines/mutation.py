@@ -123,6 +123,8 @@ TESTS: dict[str, list[str]] = {
     "renderer/glint": _first("tests/renderer/test_glint.py", DAY, ["tests/test_augmentation.py"]),
     "renderer/texture": _first("tests/renderer/test_texture.py", ["tests/test_clutter.py", "tests/test_foam.py"], DAY),
     "renderer/hits": _first("tests/renderer/test_hits.py", ["tests/renderer/test_texture.py"]),
+    "renderer/antialias": _first("tests/renderer/test_antialias.py", ["tests/renderer/test_texture.py", "tests/test_clutter.py",
+                                                                       "tests/test_foam.py"]),
     "renderer/table": _first("tests/renderer/test_table.py", RENDER, DAY, ["tests/test_clutter.py"]),
     "renderer/pixels": _first("tests/renderer/test_pixels.py", RENDER),
     "renderer/direct": _first("tests/renderer/test_table.py", RENDER, DAY, ["tests/test_clutter.py"]),
