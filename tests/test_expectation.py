@@ -806,7 +806,7 @@ def test_sky_masking_float32_agrees_with_float64_to_grazing(slopes):
     th = torch.linspace(0.0, 89.9, 60, dtype=torch.float64) * (math.pi / 180)
     ph = torch.linspace(0.0, 2 * math.pi, 13, dtype=torch.float64)
     TH, PH = torch.meshgrid(th, ph, indexing="ij")
-    sky = lambda c: 10.0 + 20.0 * (1.0 - c) ** 6  # noqa: E731
+    sky = lambda c: 10.0 + 20.0 * (1.0 - c) ** 6
 
     def ra(t, p):
         return rs.apparent_radiance(t, p, slopes, complex(1.2, 0.05), sea_radiance=30.0, sky=sky, sky_masking=True)
@@ -827,7 +827,7 @@ def test_shifted_thin_ridge_is_within_the_float64_target_of_a_converged_rule(mea
     ph = torch.arange(0.0, 360.0, 15.0, dtype=torch.float64) * (math.pi / 180)
     TH, PH = torch.meshgrid(th, ph, indexing="ij")
     slopes = rs.SlopeStatistics(0.3, 0.02, 0.0).shifted(*mean)
-    sky = lambda c: 10.0 + 20.0 * (1.0 - c) ** 6  # noqa: E731
+    sky = lambda c: 10.0 + 20.0 * (1.0 - c) ** 6
 
     def ra(q=None):
         return rs.apparent_radiance(TH, PH, slopes, complex(1.2, 0.05), sea_radiance=30.0, sky=sky, quadrature=q)
@@ -844,7 +844,7 @@ def test_black_sky_is_the_affine_end_of_eq_10():
     th = torch.linspace(0.0, 89.0, 30, dtype=torch.float64) * (math.pi / 180)
     for slopes in (rs.SlopeStatistics.cox_munk(3.0), rs.SlopeStatistics(0.2, 0.1, 0.4)):
 
-        def ra(sky):
+        def ra(sky, slopes=slopes):
             return rs.apparent_radiance(th, 0.7, slopes, complex(1.2, 0.05), sea_radiance=30.0, sky=sky)
 
         for black in (0.0, torch.tensor(0.0, dtype=torch.float64)):

@@ -54,8 +54,8 @@ def test_platform_pose_follows_the_documented_harmonic_motion():
     """pitch(t) = pitch + A_p sin(2π t/T_p + φ), roll(t) = roll + A_r sin(2π t/T_r + φ + π/2) and
     altitude(t) = altitude + A_h sin(2π t/T_h + φ) (the class docstring), for one platform and for a
     batch of platforms, over more than a period of each."""
-    kw = dict(altitude_m=20.0, pitch_deg=-3.0, roll_deg=1.0, pitch_amplitude_deg=1.5, roll_amplitude_deg=2.5,
-              heave_amplitude_m=0.7, pitch_period_s=6.0, roll_period_s=9.0, heave_period_s=7.0, phase_rad=0.4)
+    kw = {"altitude_m": 20.0, "pitch_deg": -3.0, "roll_deg": 1.0, "pitch_amplitude_deg": 1.5, "roll_amplitude_deg": 2.5,
+          "heave_amplitude_m": 0.7, "pitch_period_s": 6.0, "roll_period_s": 9.0, "heave_period_s": 7.0, "phase_rad": 0.4}
     motion = rs.PlatformMotion(**kw)
     for t in (0.0, 1.3, 2.25, 4.0, 7.7, 11.0):
         pose = motion.pose(t)

@@ -19,7 +19,7 @@ import torch
 from roughsea_torch import daysky, solar
 from roughsea_torch._tables import DATA_DIR, read_table
 from roughsea_torch.atmosphere import spectral_weights
-from roughsea_torch.radiometry import LWIR, MWIR, as_band, band_radiance
+from roughsea_torch.radiometry import as_band, band_radiance
 from roughsea_torch.solar import SOLAR_ATMOSPHERES, load_solar_irradiance, load_solar_spectral
 from roughsea_torch.sun import SUN_RADIUS
 
