@@ -498,6 +498,9 @@ NOTES[('renderer/pixels', 'table_grid() 1e-30  →  (1.01e-30)')] = (
     'scenes: night anisotropic, correlated and wide; day with the glint, with and without aerosol; nadir '
     'night and day; textured night and day; and the sweep against itself): unchanged'
 )
+NOTES[("renderer/scene", "resolved() 15e-6  →  (1.515e-05)")] = (
+    "equivalent: unreachable bound; bands must lie within the water index's 2.4–15 µm, so a band's centre never "
+    "exceeds 15 µm (tests/renderer/test_scene.py checks the three reachable edges of foam='auto')")
 STATE_BEGIN, STATE_END = "<!-- mutation-state (read by pipelines/mutation.py; keep)", "mutation-state -->"
 
 # Calls whose arguments are input checks (bounds, names, messages): not mutated.

@@ -360,3 +360,18 @@ def test_auto_foam_reaches_the_edges_of_the_measured_band_ranges(band):
     auto, none = render("auto"), render(0.0)
     torch.testing.assert_close(auto, render(float(whitecap_fraction(12.0))), rtol=1e-8, atol=0)
     assert float((auto - none).abs().max() / none.max()) > 5e-3
+
+
+@pytest.mark.parametrize("band", [(2.40e-6, 2.58e-6), (5.95e-6, 6.15e-6), (6.85e-6, 7.05e-6)],
+                         ids=["centre_2.49um", "centre_6.05um", "centre_6.95um"])
+def test_auto_foam_is_off_just_outside_the_measured_band_ranges(band):
+    """foam='auto' adds whitecaps only where the foam emissivity is measured (band centres in 2.5–6 µm
+    and 7–15 µm): a band centred 0.4–0.8 % outside either range renders exactly as foam=0 (a centre
+    above 15 µm cannot occur: bands lie within the water index's 2.4–15 µm)."""
+    cams = rs.make_camera(8, 8, hfov_deg=10.0, altitude_m=10.0, pitch_deg=-10.0, dtype=torch.float64)
+
+    def render(foam):
+        return rs.render(cams, rs.SeaScene(wind_speed=12.0, sea_temperature=290.0, band=band, sky=5.0, path=False,
+                                           foam=foam))
+
+    assert torch.equal(render("auto"), render(0.0))
