@@ -395,17 +395,17 @@ NOTES[('renderer/hits', 'sweep_layout() 1.0  →  (1.01)')] = (
     'accuracy only: 1 % more samples along the sweep (a tuning density)'
 )
 NOTES[('renderer/coordinates', 'azimuth_centre() 2 * ps  →  (2 / ps)')] = (
-    'accuracy only, measured (max relative |table − per-pixel| over 10 scenes: night anisotropic, '
+    'accuracy only, measured by pipelines/mutation_accuracy.py (max relative |table − per-pixel| over 10 scenes: night anisotropic, '
     'correlated and wide; day with the glint, with and without aerosol; nadir night and day; textured '
     'night and day; and the sweep against itself): unchanged (the lifted spans about it bound the nodes)'
 )
 NOTES[('renderer/coordinates', 'fold_range() math.pi / 2  →  (math.pi * 2)')] = (
-    'accuracy only, measured (max relative |table − per-pixel| over 10 scenes: night anisotropic, '
+    'accuracy only, measured by pipelines/mutation_accuracy.py (max relative |table − per-pixel| over 10 scenes: night anisotropic, '
     'correlated and wide; day with the glint, with and without aerosol; nadir night and day; textured '
     'night and day; and the sweep against itself): unchanged'
 )
 NOTES[('renderer/coordinates', 'camera_spans() 0.5  →  (0.505)')] = (
-    'accuracy only, measured (max relative |table − per-pixel| over 10 scenes: night anisotropic, '
+    'accuracy only, measured by pipelines/mutation_accuracy.py (max relative |table − per-pixel| over 10 scenes: night anisotropic, '
     'correlated and wide; day with the glint, with and without aerosol; nadir night and day; textured '
     'night and day; and the sweep against itself): unchanged'
 )
@@ -417,23 +417,23 @@ NOTES[('renderer/plan', 'make_plan() p.vx + p.vy  →  (p.vx)')] = (
     "the textured tests' bound is 3e-4"
 )
 NOTES[('renderer/plan', 'make_plan() 4  →  (5)')] = (
-    'accuracy only, measured (max relative |table − per-pixel| over 10 scenes: night anisotropic, '
+    'accuracy only, measured by pipelines/mutation_accuracy.py (max relative |table − per-pixel| over 10 scenes: night anisotropic, '
     'correlated and wide; day with the glint, with and without aerosol; nadir night and day; textured '
     'night and day; and the sweep against itself): unchanged to 1e-3 of each error'
 )
 NOTES[('renderer/plan', 'make_plan() 1e-4  →  (0.000101)')] = (
-    'accuracy only (the floor of ε), measured (max relative |table − per-pixel| over 10 scenes: night '
+    'accuracy only (the floor of ε), measured by pipelines/mutation_accuracy.py (max relative |table − per-pixel| over 10 scenes: night '
     'anisotropic, correlated and wide; day with the glint, with and without aerosol; nadir night and day; '
     'textured night and day; and the sweep against itself): unchanged'
 )
 NOTES[('renderer/plan', '_day_nodes_for_every_azimuth() rg_all.azimuth[1] - rg_all.azimuth[0]  →  (rg_all.azimuth[1])')] = (
     'accuracy only (whether the day tables take their whole-turn node counts; more nodes when it says '
-    'yes), measured (max relative |table − per-pixel| over 10 scenes: night anisotropic, correlated and '
+    'yes), measured by pipelines/mutation_accuracy.py (max relative |table − per-pixel| over 10 scenes: night anisotropic, correlated and '
     'wide; day with the glint, with and without aerosol; nadir night and day; textured night and day; and '
     'the sweep against itself): day with glint 3.8e-5 → 1.9e-5, the rest unchanged'
 )
 NOTES[('renderer/plan', '_day_nodes_for_every_azimuth() 1  →  (2)')] = (
-    'accuracy only, measured (max relative |table − per-pixel| over 10 scenes: night anisotropic, '
+    'accuracy only, measured by pipelines/mutation_accuracy.py (max relative |table − per-pixel| over 10 scenes: night anisotropic, '
     'correlated and wide; day with the glint, with and without aerosol; nadir night and day; textured '
     'night and day; and the sweep against itself): nadir day 1.02e-4 → 1.19e-4 (L190) or unchanged '
     "(L191); its test's bound is 0.03 K"
@@ -449,25 +449,25 @@ NOTES[('renderer/spectral', 'barycentric() 1e-15  →  (1.01e-15)')] = (
 )
 NOTES[('renderer/glint', 'reachable() (b2 * sgx * sgx - 2 * c2 * sgx * sgy + a2 * sgy * sgy) / det  →  ((b2 * sgx * sgx - 2 * c2 * sgx * sgy + a2 * sgy * sgy) * det)')] = (
     'accuracy/time only (which pixels may see the glint: a culling bound 6 σ past the reachable ellipse), '
-    'measured (max relative |table − per-pixel| over 10 scenes: night anisotropic, correlated and wide; '
+    'measured by pipelines/mutation_accuracy.py (max relative |table − per-pixel| over 10 scenes: night anisotropic, correlated and wide; '
     'day with the glint, with and without aerosol; nadir night and day; textured night and day; and the '
     'sweep against itself): unchanged, the two glint scenes included'
 )
 NOTES[('renderer/glint', 'reachable() 2.0  →  (2.02)')] = (
     'accuracy/time only (which pixels may see the glint: a culling bound 6 σ past the reachable ellipse), '
-    'measured (max relative |table − per-pixel| over 10 scenes: night anisotropic, correlated and wide; '
+    'measured by pipelines/mutation_accuracy.py (max relative |table − per-pixel| over 10 scenes: night anisotropic, correlated and wide; '
     'day with the glint, with and without aerosol; nadir night and day; textured night and day; and the '
     'sweep against itself): unchanged, the two glint scenes included'
 )
 NOTES[('renderer/glint', 'reachable() torch.sqrt(d2) - reach < 6.0  →  (torch.sqrt(d2) - reach <= 6.0)')] = (
     'accuracy/time only (which pixels may see the glint: a culling bound 6 σ past the reachable ellipse), '
-    'measured (max relative |table − per-pixel| over 10 scenes: night anisotropic, correlated and wide; '
+    'measured by pipelines/mutation_accuracy.py (max relative |table − per-pixel| over 10 scenes: night anisotropic, correlated and wide; '
     'day with the glint, with and without aerosol; nadir night and day; textured night and day; and the '
     'sweep against itself): unchanged, the two glint scenes included'
 )
 NOTES[('renderer/glint', 'reachable() 6.0  →  (6.0600000000000005)')] = (
     'accuracy/time only (which pixels may see the glint: a culling bound 6 σ past the reachable ellipse), '
-    'measured (max relative |table − per-pixel| over 10 scenes: night anisotropic, correlated and wide; '
+    'measured by pipelines/mutation_accuracy.py (max relative |table − per-pixel| over 10 scenes: night anisotropic, correlated and wide; '
     'day with the glint, with and without aerosol; nadir night and day; textured night and day; and the '
     'sweep against itself): unchanged, the two glint scenes included'
 )
