@@ -501,6 +501,20 @@ NOTES[('renderer/pixels', 'table_grid() 1e-30  →  (1.01e-30)')] = (
 NOTES[("renderer/scene", "resolved() 15e-6  →  (1.515e-05)")] = (
     "equivalent: unreachable bound; bands must lie within the water index's 2.4–15 µm, so a band's centre never "
     "exceeds 15 µm (tests/renderer/test_scene.py checks the three reachable edges of foam='auto')")
+# How the recorded state was made (printed in the report; keep it true when re-running).
+HISTORY = [
+    "How this state was made: the full pass (400 mutants) ran on 2026-11-26 between 15:55 and 17:26 UTC on the",
+    "code before the tests were reorganized to mirror the package (the old test files). After merging that",
+    "reorganization and the ray tracer, the modules whose code had changed were run again in full (slopes,",
+    "spectrum, waves, renderer/scene, renderer/table, renderer/texture, sampling, _augmentation_checks, and",
+    "augmentation, dataset, renderer/settings, sensitivity), the new modules in full (raytrace, raytrace_surface,",
+    "renderer/hits, renderer/antialias), and the survivors that new tests target were re-run (`--only-survivors`);",
+    "the run column gives each module's last run. The other modules' rows are from the first pass: their code",
+    "has not changed since, and the reorganization moved their tests' assertions without changing them.",
+    "renderer/texture and renderer/table ran just before renderer/antialias was merged (texture.py gained its call).",
+    "Survivors in the renderer's table layout were applied one at a time with `pipelines/mutation_accuracy.py`,",
+    "which measures the table against per-pixel evaluation over ten scenes; their notes quote it.",
+]
 STATE_BEGIN, STATE_END = "<!-- mutation-state (read by pipelines/mutation.py; keep)", "mutation-state -->"
 
 # Calls whose arguments are input checks (bounds, names, messages): not mutated.
@@ -858,6 +872,7 @@ def write_report(results: dict, md: Path) -> None:
                     m.original)
             note = next((notes[(mod, k)] for k in keys if (mod, k) in notes), "(not yet reviewed)")
             surv.append((mod, m, note))
+    open_ = [(mod, m, note) for mod, m, note in surv if note.startswith(("NOT KILLED", "(not yet reviewed)"))]
     lines = [
         "# Mutation testing",
         "",
@@ -874,6 +889,12 @@ def write_report(results: dict, md: Path) -> None:
         *rows,
         f"| **all** | {tot_n} | | | {len(surv)} | **{100 * tot_k / max(tot_n, 1):.0f} %** | | |",
         "",
+        f"Survivors: {len(surv)}, of which {len(surv) - len(open_)} explained below (equivalent, an argument check, or "
+        f"accuracy only, measured) and {len(open_)} open (" + (", ".join(f"`{mod}` {m.function}()" for mod, m, _ in open_) or "none")
+        + ").",
+        "",
+        *HISTORY,
+        "",
         "Mutants are a deterministic sample (`--max-per-module`, `--seed`) of every candidate in the",
         "module (12 for the core physics and the renderer's table, texture and glint, 8 elsewhere in the",
         "last full pass). `tests/test_golden.py` is not in any module's tests: it compares renders bit for",
@@ -886,15 +907,18 @@ def write_report(results: dict, md: Path) -> None:
         "",
         "Not mutated: " + "; ".join(f"`{m}` ({why})" for m, why in NOT_MUTATED.items()) + ".",
         "No candidate (no arithmetic outside argument checks): "
-        + ", ".join(f"`{m}`" for m in sorted(TESTS) if m not in results or not results[m]["mutants"]) + ".",
+        + ", ".join(f"`{m}`" for m in sorted(TESTS) if m in results and not results[m]["mutants"]) + ".",
+        "Not run yet: " + (", ".join(f"`{m}`" for m in sorted(TESTS) if m not in results) or "none") + ".",
         "",
         "## Survivors",
         "",
     ]
     if not surv:
         lines.append("None.")
-    for mod, m, note in surv:
-        lines.append(f"- `{mod}` {m.function}() {m.kind}: `{m.diff}` — {note}")
+    for mod in sorted({mod for mod, _, _ in surv}):
+        lines += [f"### `{mod}`", ""]
+        lines += [f"- {m.function}() {m.kind}: `{m.diff}` — {note}" for md, m, note in surv if md == mod]
+        lines.append("")
     lines += ["", STATE_BEGIN, json.dumps(results, indent=0, ensure_ascii=False), STATE_END]
     md.write_text("\n".join(lines) + "\n")
 
