@@ -501,6 +501,11 @@ NOTES[('renderer/pixels', 'table_grid() 1e-30  →  (1.01e-30)')] = (
 NOTES[("renderer/scene", "resolved() 15e-6  →  (1.515e-05)")] = (
     "equivalent: unreachable bound; bands must lie within the water index's 2.4–15 µm, so a band's centre never "
     "exceeds 15 µm (tests/renderer/test_scene.py checks the three reachable edges of foam='auto')")
+NOTES[("_augmentation_checks", "check_params() len(MOTION_FIELD_NAMES) + 1  →  (len(MOTION_FIELD_NAMES) - 1)")] = (
+    "argument check only: a draw missing one motion field passes this check (the motion then fails where it is built)")
+NOTES[("renderer/scene", "resolved() 1e-30  →  (1.01e-30)")] = (
+    "equivalent: the floor of a sea radiance of 0 before its brightness temperature picks the water index; no "
+    "radiance lies between 1e-30 and 1.01e-30 W m-2 sr-1")
 # How the recorded state was made (printed in the report; keep it true when re-running).
 HISTORY = [
     "How this state was made: the full pass (400 mutants) ran on 2026-11-26 between 15:55 and 17:26 UTC on the",
