@@ -433,7 +433,10 @@ def test_float32_agrees_with_float64():
 def test_foam_emissivity_takes_the_bands_hale_querry_index_up_to_the_range_edges(band, index):
     """A band centred in 2.5–6 µm takes Hale & Querry's 4 µm water index, one in 7–15 µm the 10 µm
     index (the documented default), up to the ranges' edges: the emissivity equals the one with that
-    index given, at every view zenith (where the foam excess is 0 and where it is not)."""
+    index given, at every view zenith (where the foam excess is 0 and where it is not); so does the
+    numpy reference's."""
     th = torch.linspace(0.0, math.pi / 2, 19, dtype=torch.float64)
     torch.testing.assert_close(foam_emissivity(th, band), foam_emissivity(th, band, refractive_index=index),
+                               rtol=1e-15, atol=0)
+    np.testing.assert_allclose(ref.foam_emissivity(th.numpy(), band), ref.foam_emissivity(th.numpy(), band, index),
                                rtol=1e-15, atol=0)
