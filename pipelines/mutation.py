@@ -506,6 +506,24 @@ NOTES[("_augmentation_checks", "check_params() len(MOTION_FIELD_NAMES) + 1  → 
 NOTES[("renderer/scene", "resolved() 1e-30  →  (1.01e-30)")] = (
     "equivalent: the floor of a sea radiance of 0 before its brightness temperature picks the water index; no "
     "radiance lies between 1e-30 and 1.01e-30 W m-2 sr-1")
+NOTES[("reference/sun", "__init__() det / self.lam1  →  (det * self.lam1)")] = (
+    "accuracy only: a hint to scipy's adaptive quad (the calm rule's ladder of breakpoints from the smaller eigenvalue); the integrand is unchanged")
+NOTES[("reference/sun", "__init__() 1.0  →  (1.01)")] = (
+    "accuracy only: a hint to scipy's adaptive quad: the calm rule's polar centre (the mirror of the mean facet normal) moves; the disk's ranges are solved "
+    "in closed form about any centre and the integrand is unchanged")
+NOTES[("reference/sun", "__init__() self.e1c * self.e1c + self.e2c * self.e2c  →  (self.e1c * self.e1c)")] = (
+    "equivalent: _basis(p, c) puts e1 in the plane of p and c, so e2·c = 0")
+NOTES[("reference/sun", "integral() self.d > self.R")] = "equivalent: a tie (the spike exactly on the disk's edge)"
+NOTES[("reference/foam", "foam_emissivity() 1.0  →  (1.01)")] = (
+    "equivalent for water: the cap min(1, ε_w + δ) is never reached (ε_w + δ ≤ 0.994 over every angle for "
+    "the LWIR default index, 0.978 for MWIR)")
+NOTES[("reference/foam", "sky_hemispherical_mean() 1e-13  →  (1.01e-13)")] = "accuracy only: scipy quad's relative tolerance"
+NOTES[("reference/facet_integral", "theta_max_global() 0.25 * tr * tr - det  →  (0.25 * tr * tr)")] = (
+    "accuracy only: the outer truncation angle grows (a larger eigenvalue); integrating further into the "
+    "Gaussian tail changes nothing beyond scipy's epsrel")
+NOTES[("reference/facet_integral", "principal_azimuths() 8.0  →  (8.08)")] = "accuracy only: a hint to scipy's adaptive quad (the ladder's growth factor)"
+NOTES[("reference/facet_integral", "phi_outer() 1e-2  →  (0.0101)")] = "accuracy only: the inner integral's tolerance, 1 % tighter"
+NOTES[("reference/facet_integral", "phi_outer() z - self.th  →  (z)")] = "accuracy only: a hint to scipy's adaptive quad (a breakpoint at a sky node's mirror)"
 # How the recorded state was made (printed in the report; keep it true when re-running).
 HISTORY = [
     "How this state was made: the full pass (400 mutants) ran on 2026-11-26 between 15:55 and 17:26 UTC on the",
