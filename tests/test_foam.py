@@ -21,7 +21,7 @@ import pytest
 import torch
 
 from roughsea_torch import foam
-from roughsea_torch.foam import crest_foam_fraction, whitecap_fraction
+from roughsea_torch.foam import crest_foam_fraction, foam_emissivity, whitecap_fraction
 from roughsea_torch.optics import fresnel_emissivity
 from roughsea_torch.radiometry import LWIR, MWIR, band_radiance
 from roughsea_torch.reference import foam as ref
@@ -425,3 +425,18 @@ def test_float32_agrees_with_float64():
         out.append(f.double())
     assert float((out[0] - out[1]).abs().max()) < 2e-4
     assert float(out[1].max()) > 0.5  # foam present: the comparison covers the edges
+
+
+@pytest.mark.parametrize("band, index", [((2.41e-6, 2.61e-6), 1.351 + 0.0046j), ((5.89e-6, 6.09e-6), 1.351 + 0.0046j),
+                                         ((6.91e-6, 7.11e-6), 1.218 + 0.0508j), ((14.85e-6, 15.0e-6), 1.218 + 0.0508j)],
+                         ids=["centre_2.51um", "centre_5.99um", "centre_7.01um", "centre_14.93um"])
+def test_foam_emissivity_takes_the_bands_hale_querry_index_up_to_the_range_edges(band, index):
+    """A band centred in 2.5–6 µm takes Hale & Querry's 4 µm water index, one in 7–15 µm the 10 µm
+    index (the documented default), up to the ranges' edges: the emissivity equals the one with that
+    index given, at every view zenith (where the foam excess is 0 and where it is not); so does the
+    numpy reference's."""
+    th = torch.linspace(0.0, math.pi / 2, 19, dtype=torch.float64)
+    torch.testing.assert_close(foam_emissivity(th, band), foam_emissivity(th, band, refractive_index=index),
+                               rtol=1e-15, atol=0)
+    np.testing.assert_allclose(ref.foam_emissivity(th.numpy(), band), ref.foam_emissivity(th.numpy(), band, index),
+                               rtol=1e-15, atol=0)

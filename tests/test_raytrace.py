@@ -271,3 +271,18 @@ def test_partial_sum_steps_find_the_same_hits():
     assert bool(sharp["hit"].all()) and bool(plain["hit"].all())
     assert float((sharp["t"] - plain["t"]).abs().max()) < 2e-7
     assert float(sharp["steps"].double().mean()) < 0.85 * float(plain["steps"].double().mean())
+
+
+@pytest.mark.parametrize("wind_direction", [0.0, 0.7, -2.2])
+def test_unresolved_statistics_rotate_the_traced_covariance_into_the_wind_frame(wind_direction):
+    """The slopes the tracer leaves to the expectation have the covariance Σ_total − R Σ_traced Rᵀ in
+    the (upwind, crosswind) frame, Σ_traced the traced bands' covariance in the world frame and R the
+    rotation by −(wind direction) (upwind = s·(cos w, sin w)); written here with numpy matrices."""
+    traced = torch.tensor([[0.004, 0.0015, 0.0008]], dtype=torch.float64)  # (var_x, var_y, cov_xy), world
+    total = rs.SlopeStatistics.cox_munk(10.0, anisotropic=True)
+    got = rt._unresolved_statistics(total, traced, torch.tensor([wind_direction], dtype=torch.float64))[0].numpy()
+    c, s = math.cos(wind_direction), math.sin(wind_direction)
+    rot = np.array([[c, s], [-s, c]])
+    sig = rot @ np.array([[0.004, 0.0008], [0.0008, 0.0015]]) @ rot.T
+    want = np.array([float(total.var_upwind) - sig[0, 0], float(total.var_crosswind) - sig[1, 1], float(total.cov) - sig[0, 1]])
+    np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-16)

@@ -11,7 +11,8 @@ from __future__ import annotations
 import pytest
 import torch
 
-from roughsea_torch.radiometry import band_radiance
+import roughsea_torch as rs
+from roughsea_torch.radiometry import LWIR, band_radiance
 from roughsea_torch.sensor import (
     DetectorNoise,
     FixedPatternNoise,
@@ -229,3 +230,39 @@ def test_sensor_model_stages_none_and_composition(dtype, device):
 def test_bad_arguments_raise_value_error_naming_the_argument(make, name):
     with pytest.raises(ValueError, match=name):
         make()
+
+
+def test_typical_lwir_counts_span_220_to_340_k_over_14_bits():
+    """'14 bits over 220–340 K': counts linear in the band radiance, the radiances of 220 K and 340 K
+    blackbodies at 0 and 2¹⁴ − 1 (ToCounts), so a T-kelvin blackbody is round((L(T) − L(220)) /
+    (L(340) − L(220)) · 16383); a count is ≈ 6 mK near 300 K."""
+    counts = rs.SensorModel.typical_lwir().counts
+    T = torch.tensor([220.0, 230.0, 260.0, 300.0, 300.1, 330.0, 340.0], dtype=torch.float64)
+    L = rs.band_radiance(T, LWIR)
+    lo, hi = rs.band_radiance(torch.tensor([220.0, 340.0], dtype=torch.float64), LWIR)
+    c = counts(L.view(1, 1, 1, -1)).flatten()
+    torch.testing.assert_close(c, torch.round((L - lo) / (hi - lo) * (2**14 - 1)), rtol=0, atol=0)
+    assert c[0] == 0 and c[-1] == 2**14 - 1
+    assert 0.1 / float(c[4] - c[3]) < 7e-3
+
+
+def test_typical_lwir_fixed_pattern_at_the_calibration_point():
+    """'0.1 K pixel and 0.05 K column offsets about a 300 K calibration': a uniform 300 K scene
+    through the fixed pattern alone (the gain errors vanish at the calibration point) has column means
+    of standard deviation 0.05 K and, about them, pixel offsets of standard deviation 0.1 K (1024 ×
+    1024 pixels: sampling errors 2 % and 0.07 %)."""
+    fp = rs.SensorModel.typical_lwir(seed=3).fixed_pattern
+    L = rs.band_radiance(torch.full((1, 1, 1024, 1024), 300.0, dtype=torch.float64), LWIR)
+    t = rs.brightness_temperature(fp(L), LWIR)[0, 0] - 300.0
+    cols = t.mean(0)
+    assert abs(float(cols.std()) / 0.05 - 1) < 0.1
+    assert abs(float((t - cols).std()) / 0.1 - 1) < 3e-3
+
+
+def test_to_display_over_the_full_range_is_the_min_max_stretch():
+    """low_percentile = 0 and high_percentile = 100 (the documented ends of their range) are the
+    image's minimum and maximum: the stretch is round(255 (x − min)/(max − min)) per image, the
+    minimum at 0 and the maximum at 255."""
+    x = torch.rand(2, 1, 9, 11, generator=gen(4), dtype=torch.float64) * torch.tensor([1.0, 30.0]).view(2, 1, 1, 1)
+    lo, hi = x.amin((1, 2, 3), keepdim=True), x.amax((1, 2, 3), keepdim=True)
+    torch.testing.assert_close(to_display(x, 0.0, 100.0), torch.round(255.0 * (x - lo) / (hi - lo)), rtol=0, atol=0)

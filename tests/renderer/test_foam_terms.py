@@ -4,6 +4,9 @@ matches the per-pixel evaluation. (The foam's physics: tests/test_foam.py.)"""
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import torch
 
 import roughsea_torch as rs
@@ -50,3 +53,43 @@ def test_textured_foam_sits_on_crests_keeps_the_second_law_and_matches_per_pixel
     rb = 27.5
     img = rs.render(cams, rs.SeaScene(wind_speed=20.0, sea_radiance=rb, sky=rb, path=False, seed=[5, 6]))
     torch.testing.assert_close(img[sea], torch.full_like(img[sea], rb), rtol=1e-12, atol=0.0)
+
+
+def test_foam_by_day_also_reflects_the_scattered_sky():
+    """By day a whitecap reflects the scattered sky as well as the thermal one: R_foam = ε_f R_B +
+    (1 − ε_f) E_sky/π with E_sky/π = 2 ∫₀¹ (R_s(μ) + ⟨L_day⟩_φ(μ)) μ dμ, ⟨L_day⟩_φ the day sky's mean
+    over azimuth (docs/scenes.md §5). Out of a render with a whitecap fraction of 0.3 and one without
+    (R = (1 − f) R_a + f R_foam), R_foam per sea pixel equals foam_radiance with E_sky computed here:
+    8-point Gauss–Legendre between the two tables' zenith nodes, the azimuth mean a trapezoid over
+    4001 azimuths of the scattered sky's table, to 1e-6; the day sky is 11 % of E_sky here."""
+    from roughsea_torch.daysky import load_scattered_sky
+    from roughsea_torch.foam import foam_radiance
+
+    sun_z, f = math.radians(60.0), 0.3
+    cams = make_cams(8, 8, hfov_deg=6.0, pitch_deg=-20.0, yaw_deg=torch.tensor([180.0]))  # the sun behind
+    g = rs.view_geometry(cams)
+    assert bool(g.is_sea.all())
+
+    def scene(foam):
+        return rs.SeaScene(wind_speed=3.0, sea_temperature=290.0, band=rs.MWIR, sky="midlatitude_summer", path=False,
+                           sun_zenith=sun_z, sun_azimuth=0.0, foam=foam)
+
+    with_foam, without = rs.render(cams, scene(f))[0, 0], rs.render(cams, scene(0.0))[0, 0]
+    r_foam = without + (with_foam - without) / f
+    thermal = scene(0.0).sky
+    ds = load_scattered_sky("midlatitude_summer", rs.MWIR, aerosol="maritime")
+    # μ = cos θ between every node of both tables, 8 Gauss–Legendre points in each interval
+    z = np.unique(np.concatenate([thermal.zenith.numpy(), ds.view_zenith_nodes_rad, [0.0, math.pi / 2]]))
+    edges = np.sort(np.cos(z))
+    x, w = np.polynomial.legendre.leggauss(8)
+    half, mid = 0.5 * np.diff(edges)[:, None], 0.5 * (edges[1:] + edges[:-1])[:, None]
+    mu, wt = torch.tensor((mid + half * x).ravel()), torch.tensor((half * w).ravel())
+    phi = torch.linspace(0.0, math.pi, 4001, dtype=torch.float64)
+    day = torch.trapezoid(ds(mu[:, None].expand(-1, phi.numel()), phi.expand(mu.numel(), -1),
+                             torch.full((mu.numel(), phi.numel()), sun_z, dtype=torch.float64)), phi) / math.pi
+    e_day, e_thermal = float(2 * (wt * mu * day).sum()), float(2 * (wt * mu * thermal(mu)).sum())
+    assert 0.05 < e_day / (e_day + e_thermal) < 0.2
+    rb = rs.band_radiance(torch.tensor(290.0, dtype=torch.float64), rs.MWIR)
+    m = rs.band_refractive_index(rs.MWIR, 290.0)
+    want = foam_radiance(g.view_zenith[0], rs.MWIR, rb, e_day + e_thermal, refractive_index=(m.real, m.imag))
+    torch.testing.assert_close(r_foam, want, rtol=1e-6, atol=0)

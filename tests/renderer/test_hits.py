@@ -6,10 +6,11 @@ from __future__ import annotations
 import math
 import warnings
 
+import pytest
 import torch
 
 import roughsea_torch as rs
-from roughsea_torch.renderer.hits import Sweep, centre_element, sweep_envelope, visible_average
+from roughsea_torch.renderer.hits import Sweep, centre_element, sample_step, sweep_envelope, visible_average
 
 F64 = torch.float64
 H_CAM = 10.0
@@ -135,3 +136,26 @@ def test_gradients_through_the_sweep_follow_the_image():
     fp = (mean(torch.tensor(10.0, dtype=F64), -6.0 + h) - mean(torch.tensor(10.0, dtype=F64), -6.0 - h)) / (2 * h)
     for g, f in ((gw, fw), (gp, fp)):
         assert math.isfinite(float(g)) and abs(float(g) - float(f)) < 0.1 * abs(float(f))
+
+
+def test_sample_step_is_half_the_across_scaled_cosine_clamped():
+    """The sweep's spacing (TableSize.texture_hit_*): across · cos θ̂ / 2 pixels, within [min_step, step]."""
+    for cos_view, across, want in ((0.2, 1.0, 0.1), (0.2, 2.0, 0.2), (0.9, 2.0, 0.25), (0.02, 1.0, 1 / 32), (0.1, 3.0, 0.15)):
+        assert sample_step(cos_view, 0.25, 1 / 32, across) == pytest.approx(want, rel=1e-15)
+    torch.testing.assert_close(sample_step(torch.tensor([0.2, 0.9], dtype=F64), 0.25, 1 / 32, 2.0),
+                               torch.tensor([0.2, 0.25], dtype=F64), rtol=1e-15, atol=0)
+
+
+def test_flat_sea_depression_follows_the_earths_curvature():
+    """On a sphere of radius R the sea point at horizontal distance r from a camera h above it lies at
+    depression tan γ = (R + h − R cos(r/R)) / (R sin(r/R)) ≈ (h + r²/2R)/r: the flat-sea depression
+    of the sweep and its envelope of a calm sea (η = 0) agree with the exact sphere to 1e-4 (5.7e-5:
+    the small-angle form; R = 20 km here, so the curvature is 20 % of the depression at 400 m)."""
+    R = 2.0e4
+    r = torch.linspace(20.0, 400.0, 40, dtype=F64)
+    zero = torch.zeros(1, dtype=F64)
+    sw = Sweep(r, zero, r[:, None], 0 * r[:, None], r, torch.tensor(H_CAM, dtype=F64), 0.5 / R, 0.0, 1.0)
+    exact = (R + H_CAM - R * torch.cos(r / R)) / (R * torch.sin(r / R))
+    torch.testing.assert_close(sw.flat_depression(), exact, rtol=1e-4, atol=0)
+    t, _ = sweep_envelope(sw, torch.zeros(r.shape[0], 1, dtype=F64))
+    torch.testing.assert_close(t[0], exact, rtol=1e-4, atol=0)
