@@ -137,23 +137,28 @@ def test_texture_replays_bit_for_bit_and_differs_between_draws():
 @pytest.mark.parametrize("wind", [5.0, 12.0])
 def test_texture_is_zero_mean_clutter_around_the_expectation(wind):
     """At near range (10 m up, 15° down) the texture departs from the expectation image by a
-    plausible clutter (std between 0.01 and 3 K); over four realizations the mean departure over
-    the sea pixels is a small fraction of it (the expectation is the ensemble mean; the
-    brightness temperature's curvature and four samples leave a little)."""
-    kw = dict(wind_speed=wind, pitch_deg=-15.0, altitude_m=10.0, roll_deg=0.0, hfov_deg=30.0, same_on_batch=True)
+    plausible clutter (std between 0.01 and 3 K); over eight realizations the mean departure over
+    the sea pixels is zero within 4 standard errors of the realizations' own means (the expectation
+    is the ensemble mean; the brightness temperature's curvature leaves ~1e-4 K: 0.002 K allowed).
+    A bias of 0.4 of the clutter's std (plant ``+ 0.4 * std`` on ``tex``) fails. Without whitecaps
+    (their ensemble mean: tests/renderer/test_foam_terms.py)."""
+    kw = dict(wind_speed=wind, pitch_deg=-15.0, altitude_m=10.0, roll_deg=0.0, hfov_deg=30.0, same_on_batch=True,
+              foam=0.0)  # the waves' texture (whitecaps, rare and dark, make the realizations' means heavy-tailed)
     aug = small(**kw)
     aug(torch.zeros(1, 1, H, W), generator=torch.Generator().manual_seed(0))
-    B = 4
+    B = 8
     params = {k: v.expand(B).clone() for k, v in aug._params.items() if v.ndim == 1 and v.shape[0] == 1}
-    params["wave_seed"] = torch.tensor([11, 2**40 + 3, 77777, 2**61 + 5])
+    params["wave_seed"] = torch.tensor([11, 2**40 + 3, 77777, 2**61 + 5, 5, 2**33 + 1, 424242, 2**50 + 9])
     tex = aug(torch.zeros(B, 1, H, W), params=params)
     flat = small(texture=False, **kw)(torch.zeros(B, 1, H, W), params={k: v for k, v in params.items()
                                                                        if k not in ("wave_seed", "time_s")})
     sea = rs.view_geometry(rs.make_camera(H, W, hfov_deg=30.0, altitude_m=10.0, pitch_deg=-15.0)).is_sea[0]
     d = (tex - flat)[:, 0][:, sea].double()
     std, mean = float(d.std()), float(d.mean())
+    se = float(d.mean(1).std()) / math.sqrt(B)  # the realizations' means scatter (waves longer than the image)
     assert 0.01 < std < 3.0
-    assert abs(mean) < 0.2 * std
+    assert abs(mean) < 4 * se + 0.002, (mean, se, std)
+    assert 4 * se + 0.002 < 0.4 * std  # the check can see a bias of 0.4 of the clutter
     # the realizations differ from each other (not one texture repeated)
     assert float((tex[0] - tex[1])[:, sea].abs().max()) > 0.1 * std
 

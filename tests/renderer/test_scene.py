@@ -312,7 +312,8 @@ def test_one_int_seed_gives_each_image_its_own_derived_seed():
     derived = int(np.random.SeedSequence((5, 1)).generate_state(1, np.uint64)[0] >> 1)
     alone = rs.render(make_cams(40, 12, hfov_deg=8.0, altitude_m=10.0, pitch_deg=-8.0, batch_size=1),
                       make_scene(sky=horizon_sky, path=False, seed=[derived]))
-    assert torch.equal(pair[1], alone[0])
+    # the same realization: equal to rounding (a batch's nodes may be grouped differently: 1 ulp)
+    torch.testing.assert_close(pair[1], alone[0], rtol=1e-12, atol=0.0)
     other = rs.render(cams2, make_scene(sky=horizon_sky, path=False, seed=6))
     assert float((pair[1] - other[0]).abs().max()) > 1e-4
 
