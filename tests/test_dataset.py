@@ -381,8 +381,8 @@ def test_dataset_workers_warnings_point_at_the_callers_line():
     from roughsea_torch.dataset import generate
 
     cfg = {"num_images": 2, "shard_size": 1, "batch_size": 1, "camera": {"height": 12, "width": 16},
-           "scene": {"wind_speed": [0.6, 0.8], "altitude_m": [2.0, 3.0], "pitch_deg": [-60.0, -50.0],
-                     "hfov_deg": [20.0, 30.0], "daytime": 0.0}, "sensor": {}}
+           "scene": {"wind_speed": [0.4, 0.5], "altitude_m": [2.0, 3.0], "pitch_deg": [-60.0, -50.0],
+                     "hfov_deg": [2.0, 3.0], "daytime": 0.0}, "sensor": {}}
     with tempfile.TemporaryDirectory() as d, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         generate(cfg, d, workers=1, progress=False)

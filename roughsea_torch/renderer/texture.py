@@ -34,7 +34,12 @@ from .scene import SceneParameters
 from .sky_terms import sky_per_image
 from .spectral import lobatto_interp
 
-__all__ = ["TextureTable", "sky_of_chunk", "single_quantile", "warn_scaled"]
+__all__ = ["TextureTable", "sky_of_chunk", "single_quantile", "warn_scaled", "SCALE_WARNING"]
+
+# render() warns when reconcile_scale scales some pixel's resolved slopes by less than this (their
+# variance more than halved): the texture is then markedly weaker than the spectrum alone would give.
+# Milder scalings (light winds near range, by design: docs/texture.md §7) pass silently.
+SCALE_WARNING = 0.7
 
 
 class TextureTable:
@@ -107,7 +112,7 @@ class TextureTable:
         cov = wf.resolved_covariance(L)
         ex = (slice(None),) + (None,) * (L.ndim - 1)
         lam = reconcile_scale(cov, *(getattr(self.p, k)[sl][ex] for k in ("vx", "vy", "cxy", "wind_direction")))
-        if not self.scaled and bool((lam < 1).any()):
+        if not self.scaled and bool((lam < SCALE_WARNING).any()):
             self.scaled = True  # the renderer warns once the render is done, from the caller's thread
         return tuple(c * lam * lam for c in cov), lam
 
@@ -429,5 +434,7 @@ def warn_scaled() -> None:
     warnings.warn("SeaScene(seed=...): where a pixel's footprint resolves more slope variance in the wave spectrum than "
                   "the scene's slope law allows (ECKV against Cox-Munk: light winds, centimetre footprints), the "
                   "resolved slopes are scaled down so that the two scales still add up to SlopeStatistics "
-                  "(roughsea_torch.clutter.reconcile_scale)", stacklevel=level)
+                  "(roughsea_torch.clutter.reconcile_scale); here some by more than 30 %, so the texture is weaker "
+                  "than the spectrum's. Nothing is wrong: the mean stays the slope law's; pass slopes= to use another "
+                  "law", stacklevel=level)
 
