@@ -13,8 +13,7 @@ statistics). Writes to ``--out``:
 Usage:
     python examples/render_default.py [--out outputs/default] [--batch 8] [--height 512] [--width 640]
 
-(the default ``--out`` is the repository's ``outputs/default``, from whatever directory it runs;
-the README's quick start runs it from ``examples/`` with ``--out ../outputs/default``, the same place)
+(the default ``--out`` is the repository's ``outputs/default``, from whatever directory it runs)
 """
 
 from __future__ import annotations
@@ -72,18 +71,24 @@ def main() -> None:
     print(f"rendered {args.batch} images {args.height}x{args.width} in {dt:.2f} s")
 
     titles = [
-        f"W={w:.1f} m/s T={t:.1f} K h={h:.0f} m pitch={pt:.1f}°"
+        f"W={w:.1f} m/s T_sea={t:.1f} K h={h:.0f} m pitch={pt:.1f}°"
         for w, t, h, pt in zip(p["wind_speed"].tolist(), p["sea_temperature"].tolist(),
                                p["altitude_m"].tolist(), p["pitch_deg"].tolist())
     ]
     args.out.mkdir(parents=True, exist_ok=True)
     save_grid(bt, titles, args.out / "grid_brightness_temperature.png", label="brightness temperature [K]")
     lo, hi = 250.0, 310.0
-    meta = {"band_m": [8e-6, 12e-6], "sky": args.sky, "hfov_deg": args.hfov, "bt_lo": lo, "bt_hi": hi,
-            "render_seconds": dt, "images": []}
+    res = scene.resolved(args.batch, torch.float32, torch.device("cpu"))
+    air = rs.atmosphere.surface_air_temperature(args.sky) if isinstance(sky, str) else None  # [K], the atmosphere's
+    meta = {"roughsea_torch": rs.__version__, "band_m": [8e-6, 12e-6], "sky": args.sky, "path": scene.path is not None,
+            "foam": "auto (Monahan's whitecap fraction on the crests)", "earth_radius_m": rs.EARTH_RADIUS_M,
+            "table": repr(rs.TableSize()), "image_size": [args.height, args.width], "hfov_deg": args.hfov,
+            "bt_lo": lo, "bt_hi": hi, "render_seconds": dt, "images": []}
     for i in range(args.batch):
         save_png16(bt[i, 0], args.out / f"image_{i:02d}.png", lo, hi)
         meta["images"].append({k: float(v[i]) for k, v in p.items()} | {"file": f"image_{i:02d}.png"}
+                              | {"whitecap_fraction": float(res.foam[i]) if res.foam is not None else 0.0}
+                              | ({"air_temperature": float(air)} if air is not None else {})
                               | ({"wave_seed": wave_seeds[i], "time_s": 0.0} if wave_seeds else {}))
     (args.out / "metadata.json").write_text(json.dumps(meta, indent=2))
     print(f"wrote {args.out}/grid_brightness_temperature.png, {args.batch} 16-bit PNGs and metadata.json")
