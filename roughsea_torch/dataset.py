@@ -32,7 +32,8 @@ from the ``[motion]`` ranges (:data:`~roughsea_torch.sampling.MOTION_FIELDS`). E
 re-rendered exactly by :func:`~roughsea_torch.parameter_render.render_parameters` of its item's fields
 with ``pitch_deg``, ``roll_deg``, ``altitude_m``, ``time_s`` replaced by the frame's, and its
 sensor noise drawn from ``frame_noise_seed`` (with the config's ``scene.band``, ``anisotropic``,
-``path`` and ``foam``; ``foam = false`` leaves the whitecaps out, ``"auto"`` is the default).
+``path`` and ``foam``, and the ``render`` table as ``table=TableSize(**render)``; ``foam = false`` leaves the
+whitecaps out, ``"auto"`` is the default).
 
 Determinism: item i (image or clip) is made only from (seed, i) (its parameters, wave seed,
 motion and noise streams come from
@@ -57,7 +58,7 @@ import numpy as np
 import torch
 
 from ._version import __version__
-from .dataset_config import DEFAULT_CONFIG, build_sensor, config_band, config_sampler, resolve_config
+from .dataset_config import DEFAULT_CONFIG, build_sensor, config_band, config_sampler, config_table, resolve_config
 from .parameter_render import render_clip_parameters, render_parameters
 from .sampling import MOTION_FIELDS, SCENE_FIELDS, frame_parameters, image_seed
 
@@ -109,7 +110,7 @@ def render_shard(cfg: dict[str, Any], k: int, sensor: torch.nn.Module | None = N
         for i in range(0, len(indices), bs):
             sub = {n: v[i : i + bs] for n, v in params.items()}
             kw = dict(band=config_band(sc["band"]), anisotropic=sc["anisotropic"], dtype=dtype, device=device,
-                      path=sc["path"], foam=sc["foam"])
+                      path=sc["path"], foam=sc["foam"], table=config_table(cfg))
             if T > 1:
                 L = render_clip_parameters(sub, T, cfg["frame_rate"], H, W, sampler.atmospheres, **kw)
                 seeds = frames["noise_seed"][i : i + bs]

@@ -21,11 +21,12 @@ from typing import Any
 import torch
 
 from .radiometry import LWIR, MWIR, SpectralBand, as_band
-from .renderer import check_foam
+from .renderer import TableSize, check_foam
 from .sampling import DEFAULT_TIME_S, MOTION_FIELDS, SCENE_FIELDS, SUN_FIELDS, SceneSampler, as_range
 from .sensor import DetectorNoise, FixedPatternNoise, OpticsBlur, SensorModel, ToCounts
 
-__all__ = ["DEFAULT_CONFIG", "resolve_config", "build_sensor", "config_band", "scene_sampler", "config_sampler"]
+__all__ = ["DEFAULT_CONFIG", "resolve_config", "build_sensor", "config_band", "scene_sampler", "config_sampler",
+           "config_table"]
 
 DEFAULT_CONFIG: dict[str, Any] = {
     "seed": 0,
@@ -41,6 +42,9 @@ DEFAULT_CONFIG: dict[str, Any] = {
               "daytime": 0.0, **{name: list(d) for name, _a, _u, d in SUN_FIELDS}, "sun_azimuth_relative_to_yaw": True,
               **{name: (list(d) if isinstance(d, tuple) else d) for name, _a, _u, d in SCENE_FIELDS}},
     "motion": {name: list(d) for name, _a, _u, d in MOTION_FIELDS},
+    # how textured seas are rendered (TableSize fields): the flat point or the sweep near grazing,
+    # the column filter, MWIR glitter by day
+    "render": {"texture_hit": "flat", "texture_antialias": True, "glitter": False},
     "sensor": {
         "blur": {"sigma_px": 0.7},
         "noise": {"netd_k": 0.05},
@@ -100,7 +104,10 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
     realizations' times [s], default [0, 3600)), ``clip_length`` (frames per item, integer ≥ 1;
     default 1: still images), ``frame_rate`` ([Hz], > 0, default 25; used by clips), and the
     ``motion`` table (ranges of the platform's oscillations for clips, keys of
-    :data:`~roughsea_torch.sampling.MOTION_FIELDS`: amplitudes [deg], [m], periods [s]).
+    :data:`~roughsea_torch.sampling.MOTION_FIELDS`: amplitudes [deg], [m], periods [s]). The
+    ``render`` table: ``texture_hit`` (``"flat"``, default, or ``"first"``: the sweep near grazing,
+    about 10× the time), ``texture_antialias`` (default true) and ``glitter`` (default false: MWIR
+    glitter by day), the :class:`~roughsea_torch.renderer.TableSize` fields of the same names.
     Day images: ``scene.daytime`` (probability in [0, 1] that an item is by day, default 0.0: all
     by night, no sun drawn), ``scene.sun_elevation_deg`` (range [deg] within [0, 90], default
     [2, 60]), ``scene.sun_azimuth_deg`` (range [deg], default [-180, 180]; relative to the camera's
@@ -115,6 +122,7 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
     _resolve_camera(config, cfg)
     _resolve_scene(config, cfg)
     _resolve_motion(config, cfg)
+    _resolve_render(config, cfg)
     _resolve_sensor(config, cfg)
     build_sensor(cfg)  # the stages' own range checks, before any work
     return cfg
@@ -167,6 +175,27 @@ def _resolve_scene(config: dict[str, Any], cfg: dict[str, Any]) -> None:
         scene_sampler(sc)
     except ValueError as e:
         raise ValueError(f"config: scene.{e}") from None
+
+
+def _resolve_render(config: dict[str, Any], cfg: dict[str, Any]) -> None:
+    """The ``render`` table into ``cfg``, checked by :class:`~roughsea_torch.renderer.TableSize` itself."""
+    render = config.get("render", {})
+    if not isinstance(render, dict):
+        raise ValueError(f"config: render must be a table of TableSize settings; got {render!r}")
+    _check_keys("render.", render, set(DEFAULT_CONFIG["render"]))
+    cfg["render"].update(render)
+    for key in ("texture_antialias", "glitter"):
+        if not isinstance(cfg["render"][key], bool):
+            raise ValueError(f"config: render.{key} must be true or false; got {cfg['render'][key]!r}")
+    try:
+        config_table(cfg)
+    except ValueError as e:
+        raise ValueError(f"config: render.{str(e).removeprefix('TableSize.')}") from None
+
+
+def config_table(cfg: dict[str, Any]) -> TableSize:
+    """The :class:`~roughsea_torch.renderer.TableSize` of a config's ``render`` table."""
+    return TableSize(**cfg["render"])
 
 
 def _resolve_motion(config: dict[str, Any], cfg: dict[str, Any]) -> None:

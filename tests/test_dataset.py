@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import torch
 
+import roughsea_torch as rs
 from roughsea_torch import dataset as D
 from roughsea_torch.augmentation import SceneSampler, render_parameters
 from roughsea_torch.dataset import (
@@ -218,6 +219,32 @@ def test_day_metadata_reproduces_each_image(tmp_path):
         c = sensor(render_parameters(p, 20, 28, atmospheres, band=mwir),
                    generator=torch.Generator().manual_seed(int(meta["noise_seed"])))
         assert torch.equal(c[0].round(), img)
+
+
+def test_render_table_reaches_the_shards_and_is_recorded(tmp_path):
+    """config ``render`` (TableSize fields): MWIR glitter by day. The day image's counts equal a
+    re-render from its metadata with ``TableSize(glitter=True)`` bit for bit, differ from the same
+    item without glitter, and the resolved config holds the setting; a bad value names its key."""
+    cfg = dict(DAY, render={"glitter": True})
+    generate(cfg, tmp_path, progress=False)
+    assert json.loads((tmp_path / "config.json").read_text())["config"]["render"]["glitter"] is True
+    sensor = build_sensor(resolve_config(cfg))
+    img, meta = next((i, m) for i, m in SeaShardDataset(tmp_path) if m["is_day"])
+    p = frame_render_parameters(meta)
+    p["atmosphere"] = torch.tensor([0])
+    g = torch.Generator
+    seed = int(meta["noise_seed"])
+    glitter = sensor(render_parameters(p, 20, 28, ("tropical",), band=(3e-6, 5e-6), table=rs.TableSize(glitter=True)),
+                     generator=g().manual_seed(seed))
+    plain = sensor(render_parameters(p, 20, 28, ("tropical",), band=(3e-6, 5e-6)), generator=g().manual_seed(seed))
+    assert torch.equal(glitter[0].round(), img)
+    assert not torch.equal(plain[0].round(), img)
+    with pytest.raises(ValueError, match="render.texture_hit"):
+        resolve_config(dict(CFG, render={"texture_hit": "last"}))
+    with pytest.raises(ValueError, match="render.glitter"):
+        resolve_config(dict(CFG, render={"glitter": "yes"}))
+    with pytest.raises(ValueError, match="render.speed"):
+        resolve_config(dict(CFG, render={"speed": 1}))
 
 
 def test_reader_splits_over_workers_and_converts_to_radiance(reference):
