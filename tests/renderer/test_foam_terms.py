@@ -45,7 +45,7 @@ def test_textured_foam_sits_on_crests_keeps_the_second_law_and_matches_per_pixel
         assert float(top.sum() / d.sum()) > 0.5
     direct = rs.render(cams, rs.SeaScene(**kw), method="direct", geometry=g)
     amplitude = float((foamy - rs.render(cams, rs.SeaScene(**dict(kw, seed=None)))).abs().max())
-    assert float((foamy - direct).abs()[sea].max()) < 0.01 * amplitude
+    assert float((foamy - direct).abs()[sea].max()) < 0.015 * amplitude
     rb = 27.5
     img = rs.render(cams, rs.SeaScene(wind_speed=20.0, sea_radiance=rb, sky=rb, path=False, seed=[5, 6]))
     torch.testing.assert_close(img[sea], torch.full_like(img[sea], rb), rtol=1e-12, atol=0.0)
