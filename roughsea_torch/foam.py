@@ -211,7 +211,9 @@ def _emissivity_excess(theta: torch.Tensor, eps_w: torch.Tensor, m: Any) -> torc
     (a65, d65), (a85, d85) = FOAM_EMISSIVITY_EXCESS[2], FOAM_EMISSIVITY_EXCESS[3]
     ends = torch.tensor([math.cos(math.radians(a65)), math.cos(math.radians(a85))], dtype=theta.dtype,
                         device=theta.device)
-    e = fresnel_emissivity(ends.reshape((2,) + (1,) * eps_w.ndim), m).to(eps_w.dtype)
+    # at every element (not once per index): the vectorized and scalar paths of the Fresnel terms round
+    # differently, and an image of a batch must be bitwise the image rendered alone
+    e = fresnel_emissivity(ends.reshape((2,) + (1,) * eps_w.ndim).expand((2,) + eps_w.shape), m).to(eps_w.dtype)
     mid = d65 + (d85 - d65) * (e[0] - eps_w) / (e[0] - e[1])
     return torch.where(theta <= x[-1], low, torch.where(theta <= math.radians(a85), mid, torch.full_like(mid, d85)))
 

@@ -94,7 +94,11 @@ def foam_drift(wind_speed: torch.Tensor, wind_direction: torch.Tensor) -> tuple[
     """The surface drift (v_x, v_y) [m/s] in the world frame: 3.5 % of U10 downwind (Wu 1975), the
     wind direction being the world azimuth of the UPWIND axis (the waves travel towards it + π)."""
     v = DRIFT_SHARE * wind_speed
-    return -v * torch.cos(wind_direction), -v * torch.sin(wind_direction)
+    # cos and sin image by image: their vectorized and scalar paths round differently, and image i of a
+    # batch must be bitwise the image rendered alone
+    cos = torch.cat([torch.cos(wind_direction[i:i + 1]) for i in range(wind_direction.shape[0])])
+    sin = torch.cat([torch.sin(wind_direction[i:i + 1]) for i in range(wind_direction.shape[0])])
+    return -v * cos, -v * sin
 
 
 def deposit_epochs(time_s: torch.Tensor, decay_s: float = RESIDUAL_DECAY_S, interval_s: float = DEPOSIT_INTERVAL_S,
@@ -114,8 +118,10 @@ def deposit_epochs(time_s: torch.Tensor, decay_s: float = RESIDUAL_DECAY_S, inte
     j = torch.arange(n, dtype=torch.float64, device=time_s.device)
     newest = torch.floor(time_s / interval_s) * interval_s
     epochs = newest[:, None] - interval_s * j
-    w = torch.exp(-(time_s[:, None] - epochs) / decay_s)
-    return epochs, w / w.sum(-1, keepdim=True)
+    # exp(−(t − tⱼ)/τ) = exp(−(t − t₀)/τ) exp(−j Δ/τ): the first factor cancels in the normalization, so the
+    # weights are one (J,) row for every image (and image i of a batch is bitwise the image alone)
+    w = torch.exp(-interval_s * j / decay_s)
+    return epochs, (w / w.sum()).expand(time_s.shape[0], n)
 
 
 def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tensor, footprint: torch.Tensor | None,

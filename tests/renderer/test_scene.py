@@ -302,7 +302,6 @@ def test_numpy_integer_seeds_are_ints():
             seeded_scene(seed=bad)
 
 
-@pytest.mark.filterwarnings("ignore:wind_speed above 25 m/s:UserWarning")  # winds past the whitecap law's cap (tests/test_foam.py)
 def test_one_int_seed_gives_each_image_its_own_derived_seed():
     """seed=int with B > 1 images: image i is the realization of SeedSequence((seed, i)) (documented
     in SeaScene), so images differ from each other and from the neighbouring int seed's."""
