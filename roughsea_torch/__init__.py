@@ -40,7 +40,7 @@ from .slopes import SlopeStatistics, slope_pdf
 from .waves import WaveField, elfouhaily_spectrum
 from .motion import PlatformMotion, render_clip
 from .sun import Sun, glint_radiance
-from . import atmosphere, augmentation, clutter, dataset, foam, glitter, renderer, sensor, sun, waves  # noqa: E402  (submodules as attributes: rs.sensor, ...)
+from . import atmosphere, augmentation, clutter, dataset, foam, glitter, renderer, sensor, sun, waves, whitecaps  # noqa: E402  (submodules as attributes: rs.sensor, ...)
 from .augmentation import RandomSeaBackground, RandomSeaClip, SceneSampler
 from .dataset import SeaShardDataset
 from .sensor import SensorModel
@@ -55,6 +55,7 @@ __all__ = [
     "foam",
     "sun",
     "waves",
+    "whitecaps",
     "WaveField",
     "PlatformMotion",
     "Sun",

@@ -46,7 +46,7 @@ from ._parallel import map_chunks
 from ._validation import as_tensor, check_finite_range, check_same_device
 from .atmosphere import as_sky
 from .facets import FacetGeometry, denominator, facet_geometry, normal_cdf, normal_pdf, prepare_inputs
-from .foam import foam_radiance, sky_hemispherical_mean, with_foam
+from .foam import foam_radiance, foam_sky_radiance, with_foam
 from .optics import fresnel_terms, split_refractive_index
 from .quadrature import Quadrature, gauss_nodes
 from .radiometry import LWIR
@@ -447,7 +447,7 @@ def apparent_radiance(
             R_B), off by default as in the paper; Mitsuba 3's rough dielectrics include it.
         foam_fraction: ``None`` (default, no foam) or the whitecap fraction f in [0, 1] (e.g.
             :func:`~roughsea_torch.foam.whitecap_fraction` of the wind): (1 − f) R_a + f R_foam,
-            R_foam = ε_f R_B + (1 − ε_f) E_sky/π (:mod:`roughsea_torch.foam`).
+            R_foam = ε_f R_B + (1 − ε_f) S (:mod:`roughsea_torch.foam`).
 
     Returns:
         R_a, the broadcast shape of the inputs (including a batched sky's leading dims).
@@ -473,7 +473,7 @@ def apparent_radiance(
         out = out + glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun, shadowing, sun_masking)
     if foam_fraction is not None:
         check_finite_range("foam_fraction", foam_fraction, 0.0, 1.0)
-        e_sky = sky_hemispherical_mean(as_sky(sky), dtype=out.dtype, device=out.device)
+        e_sky = foam_sky_radiance(as_sky(sky), LWIR, refractive_index, dtype=out.dtype, device=out.device)
         rf = foam_radiance(as_tensor(view_zenith, out.dtype, out.device), LWIR, rb.to(out.dtype), e_sky,
                            refractive_index=refractive_index)
         out = with_foam(out, as_tensor(foam_fraction, out.dtype, out.device), rf)

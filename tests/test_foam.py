@@ -48,39 +48,54 @@ def test_whitecap_published_values(u10, percent, digits):
     assert abs(float(w) * 100 - percent) <= 0.5 * 10.0**-digits
 
 
-def test_whitecap_zero_monotone_and_capped():
-    u = torch.linspace(0.0, 60.0, 601, dtype=torch.float64)
-    w = foam.whitecap_fraction(u)
-    assert float(w[0]) == 0.0
-    assert torch.all(torch.diff(w) >= 0)
-    assert torch.all(torch.diff(w)[(u[:-1] > 0) & (u[1:] < 38.0)] > 0)  # strictly increasing below the cap
-    assert float(w.max()) == 1.0
-    cap = (1 / 3.84e-6) ** (1 / 3.41)
-    assert float(foam.whitecap_fraction(cap * 0.999)) < 1.0 and float(foam.whitecap_fraction(cap * 1.001)) == 1.0
+def test_whitecap_zero_monotone_and_capped_at_the_end_of_its_data():
+    """The law over its data (to 25 m/s): 0 at calm, strictly increasing, silent; beyond, held at the
+    closed form W(25) = 3.84e-6 · 25^3.41 = 0.2245 with a UserWarning (the old code went on silently to
+    a sea all foam at 38.7 m/s, gradient exactly 0, no warning)."""
+    import warnings
+
+    u = torch.linspace(0.0, 25.0, 251, dtype=torch.float64)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        w = foam.whitecap_fraction(u)
+    assert float(w[0]) == 0.0 and torch.all(torch.diff(w) > 0)
+    cap = 3.84e-6 * 25.0**3.41
+    assert cap == pytest.approx(0.2245, abs=5e-5)
+    for above in (25.5, 38.7, 60.0):
+        with pytest.warns(UserWarning, match=r"25 m/s.*Monahan"):
+            assert float(foam.whitecap_fraction(torch.tensor(above, dtype=torch.float64))) == pytest.approx(cap, rel=1e-12)
+    with pytest.warns(UserWarning, match="held"):
+        np.testing.assert_allclose(ref.whitecap_fraction(np.array([10.0, 30.0])), [3.84e-6 * 10**3.41, cap], rtol=1e-12)
 
 
-# -- foam emissivity, Niclòs et al. 2007 -------------------------------------------------------
+# -- foam emissivity, Niclòs et al. 2007 and Branch et al. 2016 ---------------------------------
 
 
 @pytest.mark.parametrize("band", [LWIR, MWIR])
 def test_foam_emissivity_measured_excess(band):
-    """Foam minus foam-free emissivity: negligible at nadir and up to 45°, +0.04 at 65° (Niclòs 2007)."""
-    th = torch.tensor([0.0, math.radians(30), math.radians(45), math.radians(65)], dtype=torch.float64)
+    """Foam minus flat-water emissivity: negligible at nadir and up to 45°, +0.04 at 65° (Niclòs 2007),
+    0.23 at 85° (Branch 2016's maximum, 8.9 µm), held to 90°; between 65° and 85° linear in the water's
+    emissivity (at 75°: 0.04 + 0.19 (ε_w(65°) − ε_w(75°)) / (ε_w(65°) − ε_w(85°))). The old model
+    (Niclòs's slope continued) gave 0.08 at 85° and fails here."""
+    deg = [0.0, 30.0, 45.0, 65.0, 75.0, 85.0, 88.0, 90.0]
+    th = torch.tensor([math.radians(a) for a in deg], dtype=torch.float64)
     m = 1.218 + 0.0508j if band == LWIR else 1.351 + 0.0046j
+    ew = lambda a: float(fresnel_emissivity(torch.tensor(math.cos(math.radians(a)), dtype=torch.float64), m))  # noqa: E731
+    d75 = 0.04 + 0.19 * (ew(65) - ew(75)) / (ew(65) - ew(85))
     diff = foam.foam_emissivity(th, band) - fresnel_emissivity(torch.cos(th), m)
-    np.testing.assert_allclose(diff.numpy(), [0.0, 0.0, 0.0, 0.04], atol=1e-12)
+    np.testing.assert_allclose(diff.numpy(), [0.0, 0.0, 0.0, 0.04, d75, 0.23, 0.23, 0.23], atol=1e-12)
 
 
 def test_foam_emissivity_values_and_angular_flattening():
-    th = torch.tensor([0.0, math.radians(65), math.radians(85)], dtype=torch.float64)
+    """Branch et al. 2016: the emissivity of both falls above 65°, foam's less; the difference grows
+    with angle."""
+    th = torch.deg2rad(torch.tensor([0.0, 65.0, 70.0, 75.0, 80.0, 85.0], dtype=torch.float64))
     eps_f = foam.foam_emissivity(th, LWIR)
     eps_w = fresnel_emissivity(torch.cos(th), 1.218 + 0.0508j)
     assert float(eps_f[0]) == pytest.approx(0.98982, abs=5e-5)  # = water at nadir (docs/physics.md §13)
-    assert float(eps_f[1]) == pytest.approx(float(eps_w[1]) + 0.04, abs=1e-12)
-    assert float(eps_f[2] - eps_w[2]) == pytest.approx(0.08, abs=1e-12)  # extrapolated slope
     assert torch.all(eps_f >= eps_w) and torch.all(eps_f <= 1)
-    # foam reduces the angular variation (Niclòs 2007)
-    assert float(eps_f[0] - eps_f[1]) < float(eps_w[0] - eps_w[1])
+    assert torch.all(torch.diff(eps_f[1:]) < 0) and torch.all(torch.diff((eps_f - eps_w)[1:]) > 0)
+    assert torch.all(eps_f[1] - eps_f[2:] < eps_w[1] - eps_w[2:])  # foam falls less than water
 
 
 def test_foam_emissivity_rejects_visible_band():
@@ -100,6 +115,42 @@ def test_second_law_sky_equals_sea(dtype, tol):
     r = foam.foam_radiance(th, LWIR, rb, e)
     torch.testing.assert_close(r, rb.expand_as(r), rtol=tol, atol=0)
     assert r.dtype == dtype
+
+
+@pytest.mark.parametrize("reflection", ["reciprocal", "lambertian"])
+@pytest.mark.parametrize("dtype, tol", DTYPES)
+def test_second_law_with_the_reflected_sky(reflection, dtype, tol):
+    """A sky at the sea's blackbody radiance: the sky the foam reflects is R_B (a weighted mean), so
+    foam reads R_B whatever its emissivity, in both bands, for batched indices too."""
+    rb = band_radiance(torch.tensor(291.0, dtype=dtype))
+    th = torch.linspace(0, math.pi / 2, 19, dtype=dtype)
+    for band in (LWIR, MWIR):
+        s = foam.foam_sky_radiance(lambda mu: rb.expand(mu.shape), band, reflection=reflection, dtype=dtype)
+        torch.testing.assert_close(foam.foam_radiance(th, band, rb, s), rb.expand(19), rtol=tol, atol=0)
+    idx = (torch.tensor([1.2, 1.3, 1.35], dtype=dtype), torch.tensor([0.05, 0.01, 0.0046], dtype=dtype))
+    s = foam.foam_sky_radiance(lambda mu: rb.expand(mu.shape), LWIR, idx, reflection=reflection, dtype=dtype)
+    assert s.shape == ((3,) if reflection == "reciprocal" else ()) and s.dtype == dtype
+    torch.testing.assert_close(s.expand(3), rb.expand(3), rtol=tol, atol=0)
+
+
+def test_reciprocal_reflection_weights_the_warm_horizon():
+    """The foam reflects the sky weighted by its own reflectance 1 − ε_f, which grows towards grazing:
+    for a sky warming towards the horizon it reflects more than the cosine-weighted mean E_sky/π, and
+    for a sky warming towards the zenith less; a constant sky gives the constant; the weights are
+    ∝ (1 − ε_f(μ)) μ (checked at the nodes against the flat-water Fresnel emissivity plus Δ)."""
+    horizon = lambda mu: 10.0 + 20.0 * (1 - mu) ** 4  # noqa: E731
+    zenith = lambda mu: 10.0 + 20.0 * mu**4  # noqa: E731
+    for sky in (horizon, zenith):
+        s_r = float(foam.foam_sky_radiance(sky, LWIR, dtype=torch.float64))
+        s_l = float(foam.foam_sky_radiance(sky, LWIR, reflection="lambertian", dtype=torch.float64))
+        assert (s_r > s_l + 0.5) if sky is horizon else (s_r < s_l - 0.5)
+    assert float(foam.foam_sky_radiance(lambda mu: torch.full_like(mu, 7.0), MWIR, dtype=torch.float64)) == pytest.approx(7.0, rel=1e-14)
+    mu, w = foam.foam_sky_weights(LWIR, dtype=torch.float64)
+    assert float(w.sum()) == pytest.approx(1.0, rel=1e-14) and bool((w > 0).all())
+    rho = 1 - ref.foam_emissivity(np.arccos(mu.numpy()), LWIR)
+    _, w_l = foam.foam_sky_weights(LWIR, reflection="lambertian", dtype=torch.float64)
+    ratio = (w / w_l).numpy() / rho
+    np.testing.assert_allclose(ratio, ratio[0], rtol=1e-12)
 
 
 def test_hemispherical_mean_exact_for_polynomials():
@@ -127,7 +178,7 @@ def test_mixture_end_points(dtype):
 
 @pytest.mark.parametrize("dtype, tol", DTYPES)
 def test_torch_matches_reference(dtype, tol):
-    u = np.array([0.0, 0.5, 3.0, 7.0, 12.0, 25.0, 40.0])
+    u = np.array([0.0, 0.5, 3.0, 7.0, 12.0, 20.0, 25.0])
     np.testing.assert_allclose(
         foam.whitecap_fraction(torch.tensor(u, dtype=dtype)).double().numpy(), ref.whitecap_fraction(u), rtol=tol
     )
@@ -143,6 +194,13 @@ def test_torch_matches_reference(dtype, tol):
     e_ref = ref.sky_hemispherical_mean(sky)
     e = foam.sky_hemispherical_mean(tsky, dtype=dtype)
     assert float(e) == pytest.approx(e_ref, rel=tol)
+    for band in (LWIR, MWIR):
+        for reflection in ("reciprocal", "lambertian"):
+            s = foam.foam_sky_radiance(tsky, band, reflection=reflection, dtype=dtype)
+            assert float(s) == pytest.approx(ref.foam_sky_radiance(sky, band, reflection=reflection), rel=tol)
+    m = (1.3, 0.02)
+    s = foam.foam_sky_radiance(tsky, LWIR, (torch.tensor(m[0], dtype=dtype), torch.tensor(m[1], dtype=dtype)), dtype=dtype)
+    assert float(s) == pytest.approx(ref.foam_sky_radiance(sky, LWIR, complex(*m)), rel=tol)
     rb = 30.0
     r = foam.foam_radiance(torch.tensor(th, dtype=dtype), LWIR, torch.tensor(rb, dtype=dtype), e)
     np.testing.assert_allclose(r.double().numpy(), ref.foam_radiance(th, LWIR, rb, e_ref), rtol=tol)
@@ -176,6 +234,15 @@ def test_gradient_through_whitecap_fraction():
     assert float(g0) == 0.0
 
 
+def test_gradcheck_foam_sky_radiance():
+    """Through the reflected sky: in the water's index (n, k) and the sky's level."""
+    n = torch.tensor([1.22, 1.3], dtype=torch.float64, requires_grad=True)
+    k = torch.tensor([0.05, 0.01], dtype=torch.float64, requires_grad=True)
+    a = torch.tensor(12.0, dtype=torch.float64, requires_grad=True)
+    fn = lambda n_, k_, a_: foam.foam_sky_radiance(lambda mu: a_ + 20 * (1 - mu) ** 6, LWIR, (n_, k_))  # noqa: E731
+    assert torch.autograd.gradcheck(fn, (n, k, a))
+
+
 def test_gradcheck_foam_radiance():
     th = torch.tensor([0.2, 0.9, 1.3], dtype=torch.float64, requires_grad=True)
     rb = torch.tensor(30.0, dtype=torch.float64, requires_grad=True)
@@ -200,6 +267,9 @@ def test_gradcheck_foam_radiance():
         (lambda: foam.with_foam(1.0, 0.5, float("inf")), "foam_radiance"),
         (lambda: foam.sky_hemispherical_mean(lambda mu: mu, n=0), "n"),
         (lambda: foam.sky_hemispherical_mean(-3.0), "sky"),
+        (lambda: foam.foam_sky_radiance(lambda mu: mu, reflection="mirror"), "reflection"),
+        (lambda: foam.foam_sky_radiance(lambda mu: mu, n=0), "n"),
+        (lambda: foam.foam_sky_weights((0.4e-6, 0.7e-6)), "band"),
     ],
 )
 def test_value_errors(call, name):

@@ -4,28 +4,35 @@ Same physics as ``roughsea_torch.foam`` (see its docstring for sources and what 
 independent of it:
 
 - Whitecap fraction, Monahan & O'Muircheartaigh 1980 (J. Phys. Oceanogr. 10, 2094-2099):
-  W = min(1, 3.84e-6 * U10**3.41), U10 [m/s] at 10 m.
+  W = 3.84e-6 * min(U10, 25)**3.41, U10 [m/s] at 10 m; a UserWarning above 25 m/s (the end of the
+  law's data).
 - Foam emissivity: eps_f = min(1, eps_w(theta) + delta(theta)), eps_w = 1 - Fresnel reflectance
   of flat water, delta linear in theta [deg] through (0, 0), (45, 0), (65, 0.04) (Niclos et al.
-  2007, J. Geophys. Res. 112, C12020) and (90, 0.09) (extrapolation of that slope).
-- Foam radiance: eps_f R_B + (1 - eps_f) E_sky/pi.
-- E_sky/pi = (1/pi) int R_s cos(theta) d omega = 2 int_0^1 R_s(mu) mu dmu, by adaptive quadrature.
+  2007, J. Geophys. Res. 112, C12020); from 65 to 85 deg linear in eps_w from 0.04 to 0.23 at 85 deg
+  (Branch et al. 2016, their maximum, 8.9 um); 0.23 beyond.
+- Foam radiance: eps_f R_B + (1 - eps_f) S.
+- S, the sky the foam reflects: "reciprocal" S = int rho_f R_s mu dmu / int rho_f mu dmu with
+  rho_f = 1 - eps_f (mu = cos of the incidence zenith); "lambertian" S = E_sky/pi =
+  2 int_0^1 R_s(mu) mu dmu. Adaptive quadrature, split at the kinks of delta.
 - Mixture: (1 - f) R_a + f R_foam.
 """
 
 import math
+import warnings
 
 import numpy as np
 from scipy import integrate
 
 from .fresnel import fresnel_reflectance
 
-__all__ = ["whitecap_fraction", "foam_emissivity", "foam_radiance", "sky_hemispherical_mean", "with_foam"]
+__all__ = ["whitecap_fraction", "foam_emissivity", "foam_radiance", "sky_hemispherical_mean", "foam_sky_radiance",
+           "with_foam"]
 
 A_MONAHAN = 3.84e-6
 B_MONAHAN = 3.41
-EXCESS_DEG = np.array([0.0, 45.0, 65.0, 90.0])
-EXCESS = np.array([0.0, 0.0, 0.04, 0.09])
+U_MAX = 25.0
+EXCESS_DEG = np.array([0.0, 45.0, 65.0])
+EXCESS = np.array([0.0, 0.0, 0.04])
 
 
 def _check(name, x, lo, hi):
@@ -36,11 +43,13 @@ def _check(name, x, lo, hi):
 
 
 def whitecap_fraction(wind_speed):
-    """W = min(1, 3.84e-6 U10^3.41); wind_speed U10 [m/s] >= 0."""
+    """W = 3.84e-6 min(U10, 25)^3.41; wind_speed U10 [m/s] >= 0; warns above 25 m/s."""
     u = _check("wind_speed", wind_speed, 0.0, np.inf)
     if np.any(np.isinf(u)):
         raise ValueError("wind_speed must be finite")
-    return np.minimum(1.0, A_MONAHAN * u ** B_MONAHAN)
+    if np.any(u > U_MAX):
+        warnings.warn("wind_speed above 25 m/s: whitecap fraction held at its 25 m/s value", UserWarning, stacklevel=2)
+    return A_MONAHAN * np.minimum(u, U_MAX) ** B_MONAHAN
 
 
 def _default_index(band):
@@ -58,7 +67,11 @@ def foam_emissivity(view_zenith, band=(8e-6, 12e-6), refractive_index=None):
     theta = _check("view_zenith", view_zenith, 0.0, math.pi / 2)
     m = _default_index(band) if refractive_index is None else refractive_index
     eps_w = 1.0 - fresnel_reflectance(np.cos(theta), m)
-    delta = np.interp(np.degrees(theta), EXCESS_DEG, EXCESS)
+    e65 = 1.0 - fresnel_reflectance(math.cos(math.radians(65.0)), m)
+    e85 = 1.0 - fresnel_reflectance(math.cos(math.radians(85.0)), m)
+    deg = np.degrees(theta)
+    delta = np.where(deg <= 65.0, np.interp(deg, EXCESS_DEG, EXCESS),
+                     np.where(deg <= 85.0, 0.04 + 0.19 * (e65 - eps_w) / (e65 - e85), 0.23))
     return np.minimum(1.0, eps_w + delta)
 
 
@@ -77,6 +90,26 @@ def sky_hemispherical_mean(sky, n=64):
         return _check("sky", sky, 0.0, np.inf)
     val, _ = integrate.quad(lambda mu: 2.0 * float(sky(mu)) * mu, 0.0, 1.0, epsabs=0.0, epsrel=1e-13, limit=200)
     return val
+
+
+def foam_sky_radiance(sky, band=(8e-6, 12e-6), refractive_index=None, reflection="reciprocal"):
+    """S for a scalar callable sky of mu (or a constant): the reflectance-weighted ("reciprocal") or
+    cosine-weighted ("lambertian") mean of the sky over the upper hemisphere."""
+    if reflection == "lambertian":
+        return sky_hemispherical_mean(sky)
+    if reflection != "reciprocal":
+        raise ValueError("reflection must be 'reciprocal' or 'lambertian'")
+    if not callable(sky):
+        return _check("sky", sky, 0.0, np.inf)
+
+    def rho(mu):
+        return 1.0 - float(foam_emissivity(math.acos(min(1.0, mu)), band, refractive_index))
+
+    kinks = [math.cos(math.radians(a)) for a in (85.0, 65.0, 45.0)]
+    opts = dict(epsabs=0.0, epsrel=1e-13, limit=200, points=kinks)
+    num, _ = integrate.quad(lambda mu: rho(mu) * float(sky(mu)) * mu, 0.0, 1.0, **opts)
+    den, _ = integrate.quad(lambda mu: rho(mu) * mu, 0.0, 1.0, **opts)
+    return num / den
 
 
 def with_foam(apparent_radiance, foam_fraction, foam_radiance):

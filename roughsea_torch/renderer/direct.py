@@ -18,11 +18,11 @@ from kornia.geometry.camera import PinholeCamera
 from .._validation import per_batch
 from ..clutter import footprint, pixel_resolved_slope, reconcile_scale, two_scale_statistics
 from ..expectation import Quadrature, apparent_radiance
-from ..foam import crest_foam_fraction
 from ..geometry import ViewGeometry, view_geometry
 from ..sky import select_sky
 from ..slopes import SlopeStatistics
 from ..sun import glint_radiance, sun_masking_factor
+from ..whitecaps import whitecap_cover
 from .foam_terms import foam_mix
 from .output import kelvin
 from .path import apply_path, check_path_altitude
@@ -114,8 +114,8 @@ def sea_textured_direct(geom: ViewGeometry, cameras: PinholeCamera, p: ScenePara
     L = footprint(R, cos_t, (1.0 / cameras.fx.to(dtype))[:, None, None])
     dx, dy = geom.dx, geom.dy
     time = per_batch("time_s", scene.time_s, B, torch.float64, device)  # wave phases in float64 (TextureTable)
-    smp = wf.sample(centres[:, 0, None, None] + R * dx, centres[:, 1, None, None] + R * dy, time, footprint=L,
-                    elevation=False, crest=p.foam is not None)
+    xw, yw = centres[:, 0, None, None] + R * dx, centres[:, 1, None, None] + R * dy
+    smp = wf.sample(xw, yw, time, footprint=L, elevation=False, crest=p.foam is not None)
     cov = wf.resolved_covariance(L)
     l_ = reconcile_scale(cov, *(getattr(p, k)[:, None, None] for k in ("vx", "vy", "cxy", "wind_direction")))
     x, var_a, kap = pixel_resolved_slope(l_ * smp["slope_x"], l_ * smp["slope_y"], tuple(c * l_ * l_ for c in cov),
@@ -142,9 +142,10 @@ def sea_textured_direct(geom: ViewGeometry, cameras: PinholeCamera, p: ScenePara
         if scene.sun_masking:
             g = g * sun_masking_factor(SlopeStatistics.from_variances(vx, vy, cxy), sun, dtype, device)
         vals = vals + g
-    if p.foam is not None:  # whitecaps on the crests (foam.crest_foam_fraction)
-        f = crest_foam_fraction(smp["crest"], wf.crest_variance(L), wf.crest_variance()[:, None, None],
-                                p.foam.to(dtype)[:, None, None])
+    if p.foam is not None:  # whitecaps on the crests and their residual foam (whitecaps.whitecap_cover)
+        f_act, f_res = whitecap_cover(wf, xw, yw, time, L, smp["crest"], wf.crest_variance(L),
+                                      wf.crest_variance()[:, None, None], p.foam.to(dtype)[:, None, None])
+        f = f_act + f_res
         if antialias:
             f = antialias_texture(torch.zeros_like(f), torch.where(sea, f, torch.zeros_like(f)), sea)[1]
         vals = foam_mix(vals, th, p, img_idx, scene, f[sea])

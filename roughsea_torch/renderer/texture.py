@@ -22,11 +22,11 @@ import torch.nn.functional as F
 
 from .._validation import per_batch
 from ..clutter import along_view, footprint, reconcile_scale, resolved_quantile, two_scale_statistics
-from ..foam import crest_fraction_from_variances
 from ..expectation import reflection_terms
 from ..geometry import slant_range
 from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
+from ..whitecaps import whitecap_cover
 from .antialias import antialias_texture
 from .hits import Sweep, centre_element, pixel_windows, sample_step, sweep_envelope, sweep_layout, visible_average
 from .path import path_rows
@@ -256,7 +256,7 @@ class TextureTable:
                span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any, crest: bool = False) -> tuple:
         """The texture of every pixel of images ``sl`` (0 off the sea), (b, H, W); each pixel's resolved
         quantile x and resolved covariance (world frame), for the glint; and with ``crest`` its foam
-        fraction f_pix (:func:`~roughsea_torch.foam.crest_foam_fraction`, 0 off the sea), else None.
+        fraction f_pix (active and residual, :func:`~roughsea_torch.whitecaps.whitecap_cover`, 0 off the sea), else None.
 
         Pixels: cos θ̂ ``cos_t``, ζ ``zeta`` and the azimuth coordinate ``o`` (the angle, over the
         span [a, b]) of their line of sight, the ray's components along the camera's vertical ``dz``
@@ -284,10 +284,10 @@ class TextureTable:
         f_pix = None
         if crest:
             zero = torch.zeros_like(out)
-            f_pix = crest_fraction_from_variances(torch.where(sea, smp["crest"], zero), torch.where(sea, cov[:, 3], zero),
-                                                  wf.crest_variance()[:, None, None],
-                                                  self.p.foam[sl].to(dtype)[:, None, None])
-            f_pix = torch.where(sea, f_pix, zero)
+            f_act, f_res = whitecap_cover(wf, X, Y, self.time[sl], L, torch.where(sea, smp["crest"], zero),
+                                          torch.where(sea, cov[:, 3], zero), wf.crest_variance()[:, None, None],
+                                          self.p.foam[sl].to(dtype)[:, None, None])
+            f_pix = torch.where(sea, f_act + f_res, zero)
         out = torch.where(sea, out, torch.zeros_like(out))
         if self.antialias:  # the band at the rows' Nyquist folds into one-pixel lines (renderer.antialias)
             out, f_pix = antialias_texture(out, f_pix, sea)
@@ -354,9 +354,11 @@ class TextureTable:
         o = coordinate(cx[None, None, :], sx[None, None, :], i)[0].expand(ns, nt)
         values = [self._read_volume(vol[i:i + 1], x_k[None], o[None], gy[None], a[i:i + 1], b[i:i + 1])[0, 0]]
         if crest:
-            var_r = wf.crest_variance(sw.footprint[None])[0][:, None]
-            values.append(crest_fraction_from_variances(smp["crest"][0].reshape(ns, nt), var_r, wf.crest_variance()[0],
-                                                        self.p.foam[im].to(dtype)))
+            var_r = wf.crest_variance(sw.footprint[None])[:, :, None].expand(1, ns, nt).reshape(1, -1)
+            f_act, f_res = whitecap_cover(wf, sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1], fp,
+                                          smp["crest"], var_r, wf.crest_variance()[:, None],
+                                          self.p.foam[im:im + 1].to(dtype)[:, None])
+            values.append((f_act + f_res)[0].reshape(ns, nt))
         return torch.stack([v.T for v in values]), x_k, cov_k, m
 
     def _row_statistics(self, sl: slice, wf: Any, gy: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor,

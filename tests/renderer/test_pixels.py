@@ -14,6 +14,7 @@ import roughsea_torch as rs
 from conftest import make_cams, make_scene, smooth_sky, varied_cameras
 
 
+@pytest.mark.filterwarnings("ignore:wind_speed above 25 m/s:UserWarning")  # winds past the whitecap law's cap (tests/test_foam.py)
 @pytest.mark.parametrize("anisotropic", [False, True])
 def test_workspace_reused_across_calls_and_equal_to_the_autograd_path(anisotropic):
     """Without gradients through the rays, the per-pixel chain runs in place in a per-thread workspace

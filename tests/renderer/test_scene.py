@@ -351,7 +351,7 @@ def test_auto_foam_reaches_the_edges_of_the_measured_band_ranges(band):
     measured ranges, 2.5–6 µm and 7–15 µm (scenes.md §5), up to their edges (bands centred within
     0.5 % of each): the render equals the one with that fraction given explicitly (a float64 and a
     float32 evaluation of Monahan's law: 1.5e-9 apart), and the foam is there (12 m/s: 1.8 % of the
-    sea, 0.8–2 % of the radiance here)."""
+    sea, 0.4–2 % of the radiance here)."""
     cams = rs.make_camera(8, 8, hfov_deg=10.0, altitude_m=10.0, pitch_deg=-10.0, dtype=torch.float64)
 
     def render(foam):
@@ -360,7 +360,7 @@ def test_auto_foam_reaches_the_edges_of_the_measured_band_ranges(band):
 
     auto, none = render("auto"), render(0.0)
     torch.testing.assert_close(auto, render(float(whitecap_fraction(12.0))), rtol=1e-8, atol=0)
-    assert float((auto - none).abs().max() / none.max()) > 5e-3
+    assert float((auto - none).abs().max() / none.max()) > 2e-3
 
 
 @pytest.mark.parametrize("band", [(2.40e-6, 2.58e-6), (5.95e-6, 6.15e-6), (6.85e-6, 7.05e-6)],

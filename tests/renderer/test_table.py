@@ -25,6 +25,7 @@ SEA_TOL = {"fn": 2e-6, "midlatitude_summer": 2e-6}
 SKY_TOL = {"fn": 1e-6, "midlatitude_summer": 1e-4}
 
 
+@pytest.mark.filterwarnings("ignore:wind_speed above 25 m/s:UserWarning")  # 40 m/s: the whitecap law's cap (tests/test_foam.py)
 @pytest.mark.parametrize("anisotropic", [False, True])
 @pytest.mark.parametrize("sky_kind", ["fn", "midlatitude_summer"])
 def test_table_render_matches_direct_per_pixel_evaluation(dtype, anisotropic, sky_kind):

@@ -1,0 +1,161 @@
+"""Whitecaps in time: active breaking on the crests and the residual foam it leaves behind.
+
+The foam cover of a textured sea's pixel (the fraction of its footprint under foam) has two states:
+
+    f = a · B(x, t) + (1 − a) · R(x, t)                                      (:func:`whitecap_cover`)
+
+- **Active** (stage A: the crest breaking now): B(x, t) = Φ((X_r − c)/σ_u), the probability that the
+  crest variable X of the :class:`~roughsea_torch.waves.WaveField` exceeds the breaking threshold in
+  the pixel's footprint given what the pixel resolves (:func:`~roughsea_torch.foam.crest_foam_fraction`:
+  soft-edged, E[B] = W exactly).
+- **Residual** (stage B: the foam left where crests broke, decaying and drifting with the surface):
+
+      R(x, t) = Σⱼ wⱼ B(x − v (t − tⱼ), tⱼ),   wⱼ ∝ exp(−(t − tⱼ)/τ_R),  Σ wⱼ = 1,
+
+  the breaking deposited at fixed epochs tⱼ = j Δ (absolute time, Δ = :data:`DEPOSIT_INTERVAL_S`)
+  within :data:`DEPOSIT_WINDOW` decay times before t, carried since by the surface drift v, fading
+  with the decay time τ_R. The epochs are fixed in time, so in a clip a deposit stays where it was
+  laid and only drifts and fades: whitecaps form on crests, leave trails behind the crests that
+  moved on (streaks along the waves' direction, the wind's), and fade over seconds.
+
+Each B has ensemble mean W (the field is stationary: its statistics do not depend on the point or
+the time), and the weights sum to 1, so E[f] = W exactly whatever a, τ_R, v or the epochs: the
+ensemble mean of a textured storm stays the expectation's. Far field (nothing resolved): f = W.
+
+Sources and numbers
+-------------------
+- Two stages, active (A) and residual/maturing (B): Monahan & Lu (1990, IEEE Trans. Geosci. Remote
+  Sens. 28, 211–220); in airborne infrared imagery active whitecaps read bright and residual ones dark
+  (Marmorino & Smith 2005, Geophys. Res. Lett. 32, L11604).
+- Residual foam decays quasi-exponentially in area with decay constants of 0.5–8 s (Callaghan,
+  Deane, Stokes & Ward 2012, off Martha's Vineyard): τ_R = :data:`RESIDUAL_DECAY_S` = 2 s, the
+  geometric middle of that range.
+- Whitecap lifetimes are exponentially distributed, about 0.3 of the breaking wave's period
+  (Korinenko, Malinovsky, Dulov & Kudryavtsev, Black Sea platform video): taken here as the active
+  stage's duration τ_A = 0.3 T_p at the spectral peak (T_p = 2π U10 / (g Ω_c), ECKV's k_p), and the
+  active share of the cover by Little's law for two successive stages, a = τ_A / (τ_A + τ_R)
+  (:func:`active_share`; 0.63 at 15 m/s, fully developed). That the video lifetime is the active
+  stage's, and that the peak's period sets it, are this model's assumptions.
+- Foam drifts with the surface water: about 3.5 % of U10 downwind at long fetch (Wu 1975, J. Fluid
+  Mech. 68, 49–70, total surface drift including the Stokes drift): :data:`DRIFT_SHARE`.
+
+Left out: the active state is radiometrically the residual's here (the renderer gives both the
+foam radiance of :mod:`roughsea_torch.foam`); the warmer disrupted skin of active breaking (the cool
+skin is typically ~0.2 K, up to 0.5 K, below the bulk; Jessup, Zappa & Yeh 1997) and the tilt of
+the foam on the breaking face are not modelled. R's deposits are discrete epochs Δ apart: at near
+range a fast crest's trail shows as stamps Δ c apart, softened by the footprint's unresolved part.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import torch
+
+from .foam import crest_fraction_from_variances
+from .spectrum import GRAVITY
+
+__all__ = [
+    "RESIDUAL_DECAY_S",
+    "ACTIVE_PERIOD_SHARE",
+    "DRIFT_SHARE",
+    "DEPOSIT_INTERVAL_S",
+    "DEPOSIT_WINDOW",
+    "active_share",
+    "deposit_epochs",
+    "foam_drift",
+    "whitecap_cover",
+]
+
+RESIDUAL_DECAY_S = 2.0  # [s] τ_R, Callaghan et al. 2012: 0.5–8 s (geometric middle)
+ACTIVE_PERIOD_SHARE = 0.3  # τ_A / T_p, Korinenko et al.: whitecap lifetime / breaking wave period
+DRIFT_SHARE = 0.035  # surface drift / U10, Wu 1975 (long fetch)
+DEPOSIT_INTERVAL_S = 0.5  # [s] Δ, the spacing of the residual foam's deposit epochs
+DEPOSIT_WINDOW = 3.0  # deposits kept within this many τ_R before t (the rest, e^-3 = 5 %, renormalized away)
+
+
+def active_share(wind_speed: torch.Tensor, inverse_wave_age: torch.Tensor,
+                 decay_s: float = RESIDUAL_DECAY_S) -> torch.Tensor:
+    """a = τ_A / (τ_A + τ_R), τ_A = 0.3 T_p, T_p = 2π U10 / (g Ω_c) [s] (module docstring).
+
+    Args:
+        wind_speed: U10 [m/s] > 0, tensor (B,); inverse_wave_age: Ω_c, tensor (B,).
+        decay_s: τ_R [s] > 0.
+
+    Returns:
+        a in (0, 1), (B,), differentiable in the wind.
+    """
+    tau_a = ACTIVE_PERIOD_SHARE * 2.0 * math.pi * wind_speed / (GRAVITY * inverse_wave_age)
+    return tau_a / (tau_a + decay_s)
+
+
+def foam_drift(wind_speed: torch.Tensor, wind_direction: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """The surface drift (v_x, v_y) [m/s] in the world frame: 3.5 % of U10 downwind (Wu 1975), the
+    wind direction being the world azimuth of the UPWIND axis (the waves travel towards it + π)."""
+    v = DRIFT_SHARE * wind_speed
+    # cos and sin image by image: their vectorized and scalar paths round differently, and image i of a
+    # batch must be bitwise the image rendered alone
+    cos = torch.cat([torch.cos(wind_direction[i:i + 1]) for i in range(wind_direction.shape[0])])
+    sin = torch.cat([torch.sin(wind_direction[i:i + 1]) for i in range(wind_direction.shape[0])])
+    return -v * cos, -v * sin
+
+
+def deposit_epochs(time_s: torch.Tensor, decay_s: float = RESIDUAL_DECAY_S, interval_s: float = DEPOSIT_INTERVAL_S,
+                   window: float = DEPOSIT_WINDOW) -> tuple[torch.Tensor, torch.Tensor]:
+    """The residual foam's deposit epochs tⱼ = j Δ ≤ t within ``window`` τ_R before t, and their
+    weights wⱼ ∝ exp(−(t − tⱼ)/τ_R), Σ wⱼ = 1.
+
+    Args:
+        time_s: t [s], float64 tensor (B,).
+        decay_s: τ_R [s] > 0; interval_s: Δ [s] > 0; window: in units of τ_R, > 0.
+
+    Returns:
+        epochs (B, J) float64 and weights (B, J) float64, J = floor(window τ_R / Δ) + 1 (the same
+        for every image: the newest epoch is the last multiple of Δ at or before t).
+    """
+    n = int(math.floor(window * decay_s / interval_s)) + 1
+    j = torch.arange(n, dtype=torch.float64, device=time_s.device)
+    newest = torch.floor(time_s / interval_s) * interval_s
+    epochs = newest[:, None] - interval_s * j
+    # exp(−(t − tⱼ)/τ) = exp(−(t − t₀)/τ) exp(−j Δ/τ): the first factor cancels in the normalization, so the
+    # weights are one (J,) row for every image (and image i of a batch is bitwise the image alone)
+    w = torch.exp(-interval_s * j / decay_s)
+    return epochs, (w / w.sum()).expand(time_s.shape[0], n)
+
+
+def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tensor, footprint: torch.Tensor | None,
+                   crest_now: torch.Tensor, resolved_variance: torch.Tensor, total_variance: torch.Tensor,
+                   whitecap_fraction: torch.Tensor, decay_s: float = RESIDUAL_DECAY_S) -> tuple[torch.Tensor, torch.Tensor]:
+    """The active and residual foam cover (a B, (1 − a) R) of points of a wave field (module docstring).
+
+    Args:
+        wf: the :class:`~roughsea_torch.waves.WaveField` (B images).
+        x, y: the points' world coordinates [m], (B, ...), of the field's dtype and device (checked).
+        time_s: t [s], float64 (B,).
+        footprint: the points' footprints [m] (x's shape) or None.
+        crest_now: X_r at the points at t (``wf.sample_unchecked(..., crest=True)["crest"]``).
+        resolved_variance: σ_r² of X_r at the footprint, broadcasting with x; total_variance: σ_X²,
+            broadcasting; whitecap_fraction: W, broadcasting (e.g. (B, 1, ...)).
+        decay_s: τ_R [s].
+
+    Returns:
+        (f_active, f_residual), x's shape, each in [0, 1], f_active + f_residual in [0, 1], with
+        E[f_active + f_residual] = W.
+    """
+    dtype = x.dtype
+    extra = (None,) * (x.ndim - 1)
+    a = active_share(wf.wind_speed, wf.inverse_wave_age, decay_s).to(dtype)[(...,) + extra]
+    vx, vy = (v.to(dtype)[(...,) + extra] for v in foam_drift(wf.wind_speed, wf.wind_direction))
+    epochs, weights = deposit_epochs(time_s, decay_s)
+
+    def indicator(crest: torch.Tensor) -> torch.Tensor:
+        return crest_fraction_from_variances(crest, resolved_variance, total_variance, whitecap_fraction)
+
+    residual = torch.zeros_like(crest_now)
+    for j in range(epochs.shape[1]):
+        age = (time_s - epochs[:, j]).to(dtype)[(...,) + extra]
+        smp = wf.sample_unchecked(x - vx * age, y - vy * age, epochs[:, j], footprint, elevation=False, crest=True,
+                                  slopes=False)
+        residual = residual + weights[:, j].to(dtype)[(...,) + extra] * indicator(smp["crest"])
+    return a * indicator(crest_now), (1.0 - a) * residual
