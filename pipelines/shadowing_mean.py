@@ -131,7 +131,7 @@ def main() -> None:
         saved = pickle.load(fh)
     t0 = time.perf_counter()
     rows = run(saved)
-    out = write_report(args.out, "shadowing_mean_table.md", report(rows, Path(args.load).name, time.perf_counter() - t0))
+    out = write_report(args.out, "shadowing_mean.md", report(rows, Path(args.load).name, time.perf_counter() - t0))
     figure(rows, out)
 
 
