@@ -109,15 +109,25 @@ def test_seen_facets_steeper_near_grazing(backend):
 # ------------------------------------------------------------------------------------------------
 # 3. Torch against the reference
 # ------------------------------------------------------------------------------------------------
+REF_CASES = ((85.0, 0.3, (0.15, 0.12, 0.1)), (88.0, 0.0, (0.2, 0.16, 0.0)))
+
+
+@pytest.fixture(scope="module")
+def reference_correlated():
+    """(ε̄, R_a) of the numpy reference with shadowing="correlated" for REF_CASES (computed once)."""
+    out = []
+    for th_deg, ph, (a, b, r) in REF_CASES:
+        s = ref.SlopeStatistics(a, b, r)
+        out.append((float(ref.emissivity(th_deg * DEG, ph, s, M11, shadowing="correlated")),
+                    float(ref.apparent_radiance(th_deg * DEG, ph, s, M11, 30.0, smooth_sky, shadowing="correlated"))))
+    return out
+
+
 @pytest.mark.parametrize("dtype, rtol", [(torch.float64, 2e-5), (torch.float32, 4e-5)])
-def test_correlated_matches_reference(dtype, rtol):
-    for th_deg, ph, (a, b, r) in ((85.0, 0.3, (0.15, 0.12, 0.1)), (88.0, 0.0, (0.2, 0.16, 0.0))):
-        th = th_deg * DEG
-        e_ref = float(ref.emissivity(th, ph, ref.SlopeStatistics(a, b, r), M11, shadowing="correlated"))
-        r_ref = float(ref.apparent_radiance(th, ph, ref.SlopeStatistics(a, b, r), M11, 30.0, smooth_sky,
-                                            shadowing="correlated"))
+def test_correlated_matches_reference(reference_correlated, dtype, rtol):
+    for (th_deg, ph, (a, b, r)), (e_ref, r_ref) in zip(REF_CASES, reference_correlated):
         s = rs.SlopeStatistics(*(torch.tensor(v, dtype=dtype) for v in (a, b, r)))
-        t = torch.tensor(th, dtype=dtype)
+        t = torch.tensor(th_deg * DEG, dtype=dtype)
         e = float(rs.emissivity(t, ph, s, M11, shadowing="correlated"))
         ra = float(rs.apparent_radiance(t, ph, s, M11, sea_radiance=30.0, sky=smooth_sky, shadowing="correlated"))
         assert abs(e / e_ref - 1.0) < rtol, (th_deg, e, e_ref)
