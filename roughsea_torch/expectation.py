@@ -347,6 +347,9 @@ def projected_area(view_zenith: Any, view_azimuth: Any, slopes: SlopeStatistics,
         D [dimensionless]: cos θ̂ Φ(μ) + sin θ̂ σ∥ φ(μ) with μ = cot θ̂/σ∥ (= cos θ̂ (1 + Λ), Smith's
         shadowing function Λ), or cos θ̂ without shadowing (Eq. 7).
     """
+    if check_shadowing(shadowing) == "correlated":
+        raise ValueError("projected_area: shadowing must be True (Eq. 5) or False (Eq. 7); the correlated "
+                         "masking's normalization is not a projected area")
     _, _, vz, va, vx, vy, cxy, mx, my = prepare_inputs(view_zenith, view_azimuth, slopes)
     return denominator(facet_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
 

@@ -182,3 +182,11 @@ def test_bad_shadowing_is_a_value_error_naming_it(bad):
         rs.apparent_radiance(1.4, 0.0, s, M11, sea_radiance=30.0, sky=smooth_sky, shadowing=bad)
     with pytest.raises(ValueError, match="shadowing"):
         ref.emissivity(1.4, 0.0, ref.SlopeStatistics.cox_munk(5.0), M11, shadowing=bad)
+
+
+def test_projected_area_refuses_correlated():
+    """D_Q is a normalization, not a projected area: projected_area takes True/False only."""
+    with pytest.raises(ValueError, match="shadowing"):
+        rs.projected_area(1.4, 0.0, rs.SlopeStatistics.cox_munk(5.0), shadowing="correlated")
+    with pytest.raises(ValueError, match="shadowing"):
+        ref.projected_area(1.4, 0.0, ref.SlopeStatistics.cox_munk(5.0), shadowing="correlated")

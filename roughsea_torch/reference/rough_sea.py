@@ -194,6 +194,8 @@ def projected_area(view_zenith, view_azimuth, slopes, shadowing=True, *, epsrel=
     With shadowing=False and th = pi/2 exactly the (zero-mean) integral is 0 (cos(pi/2)); it is
     computed with an absolute tolerance of 1e-15 there.
     """
+    if check_shadowing(shadowing) == "correlated":
+        raise ValueError("projected_area: shadowing must be True or False")
     shadowing = check_shadowing(shadowing)
     th, ph = check_view(view_zenith, view_azimuth)
     a, b, r = slope_arrays(slopes)
