@@ -47,6 +47,7 @@ from ._validation import as_tensor, check_finite_range, check_same_device
 from .atmosphere import as_sky
 from .facets import FacetGeometry, denominator, facet_geometry, normal_cdf, normal_pdf, prepare_inputs
 from .foam import foam_radiance, foam_sky_radiance, with_foam
+from .masking import check_shadowing, masked_denominator, masking_ratio, view_nu
 from .optics import fresnel_terms, split_refractive_index
 from .quadrature import Quadrature, gauss_nodes
 from .radiometry import LWIR
@@ -104,6 +105,8 @@ def _emissivity_numerator(
         half = 0.5 * (hi - lo)
         x = (0.5 * (hi + lo))[:, None] + half[:, None] * xg  # (m, no)
         W = half[:, None] * wg * normal_pdf(x)
+        if shadowing == "correlated":  # the slope-conditioned masking (roughsea_torch.masking)
+            W = W * masking_ratio(x, view_nu(g)[:, None])
         du = g.su[:, None] * x
         u = g.mu[:, None] + du
         t = g.ct[:, None] + g.st[:, None] * u
@@ -123,6 +126,7 @@ def _sky_numerator(
     q: Quadrature,
     split: bool,
     masking: bool = False,
+    shadowing: bool | str = True,
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """(∫_C N t ρ(Ω) R_s(θ') ds, ∫_C N t ρ(Ω) ds) over the disc C of sky-reflecting facets; with
     ``masking`` each ρ times Smith's G1 of the reflected ray (the masked part of the ray sees the
@@ -143,6 +147,8 @@ def _sky_numerator(
     h = (inv_ct * torch.sin(psi0[:, None] + delta)).clamp_min(0.0)  # half-chord = du/dψ
     x = (u - mu[:, None]) / su[:, None]
     W = wdelta * h * normal_pdf(x) / su[:, None]
+    if shadowing == "correlated":  # the slope-conditioned masking (roughsea_torch.masking)
+        W = W * masking_ratio(x, view_nu(g)[:, None])
     t = ct[:, None] + st[:, None] * u
     c = mv[:, None] + g.kappa[:, None] * (u - mu[:, None])
     tau = g.tau[:, None]
@@ -249,6 +255,7 @@ def _sky_terms(
     D: torch.Tensor,
     q: Quadrature,
     masking: bool = False,
+    shadowing: bool | str = True,
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """Flat (T_s, T_ρ) = (1/D)(∫_C N t ρ R_s, ∫_C N t ρ), so that R_a = R_B (1 − T_ρ) + T_s (Eq. 10).
 
@@ -267,7 +274,7 @@ def _sky_terms(
 
         def one(sel: torch.Tensor, split: bool = split) -> tuple[torch.Tensor, torch.Tensor]:
             i_s, i_r = _sky_numerator(g.take(sel), n[sel], k[sel], _sky_chunk(sky_fn, shape, sel, device), q, split,
-                                      masking)
+                                      masking, shadowing)
             return i_s / D[sel], i_r / D[sel]
 
         # chunks on worker threads of one intra-op thread each (roughsea_torch._parallel)
@@ -340,6 +347,9 @@ def projected_area(view_zenith: Any, view_azimuth: Any, slopes: SlopeStatistics,
         D [dimensionless]: cos θ̂ Φ(μ) + sin θ̂ σ∥ φ(μ) with μ = cot θ̂/σ∥ (= cos θ̂ (1 + Λ), Smith's
         shadowing function Λ), or cos θ̂ without shadowing (Eq. 7).
     """
+    if check_shadowing(shadowing) == "correlated":
+        raise ValueError("projected_area: shadowing must be True (Eq. 5) or False (Eq. 7); the correlated "
+                         "masking's normalization is not a projected area")
     _, _, vz, va, vx, vy, cxy, mx, my = prepare_inputs(view_zenith, view_azimuth, slopes)
     return denominator(facet_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
 
@@ -357,7 +367,7 @@ def emissivity(
     view_azimuth: Any,
     slopes: SlopeStatistics,
     refractive_index: Any = 1.218 + 0.0508j,
-    shadowing: bool = True,
+    shadowing: bool | str = True,
     quadrature: Quadrature | None = None,
 ) -> torch.Tensor:
     """Rough-sea emissivity ε̄(θ̂, φ̂) = ∫∫ f̂ [1 − ρ(Ω)] dθ dφ (Eq. 5 weights; Eq. 7 without shadowing).
@@ -368,7 +378,9 @@ def emissivity(
         slopes: :class:`SlopeStatistics` (floats or tensors).
         refractive_index: m = n + i k of the sea (k ≥ 0): complex, complex tensor or (n, k).
         shadowing: Eq. 5 (True, default) or Eq. 7 (False; facets turned away then count with
-            negative weight and ρ at |cos Ω|, as Eq. 4 is written).
+            negative weight and ρ at |cos Ω|, as Eq. 4 is written); or "correlated": Eq. 5 with the
+            slope-conditioned masking of :mod:`roughsea_torch.masking` (facets tilted towards the
+            sensor weigh more near grazing).
         quadrature: accuracy control; ``Quadrature.default(dtype)`` when None.
 
     Returns:
@@ -379,6 +391,7 @@ def emissivity(
         >>> round(float(emissivity(0.0, 0.0, s, 1.218 + 0.0508j)), 4)
         0.9898
     """
+    shadowing = check_shadowing(shadowing)
     dtype, device, vz, va, vx, vy, cxy, mx, my = prepare_inputs(view_zenith, view_azimuth, slopes, refractive_index)
     n, k = split_refractive_index(refractive_index, dtype, device)
     q = quadrature or Quadrature.default(dtype)
@@ -387,7 +400,7 @@ def emissivity(
     vz, va, vx, vy, cxy, n, k = (t.to(work) for t in (vz, va, vx, vy, cxy, n, k))
     mx, my = (None if t is None else t.to(work) for t in (mx, my))
     g = facet_geometry(vz, va, vx, vy, cxy, mx, my).flat(shape)
-    D = denominator(g, shadowing)
+    D = _denominator(g, shadowing, q)
     nf, kf = n.expand(shape).reshape(-1), k.expand(shape).reshape(-1)
     points = q.outer * q.hermite * (1 if shadowing else 2)
 
@@ -395,6 +408,13 @@ def emissivity(
         return (_emissivity_numerator(g.take(sl), nf[sl], kf[sl], shadowing, q) / D[sl]).to(dtype)
 
     return _run_chunked(shape, points, q, one, dtype, device)
+
+
+def _denominator(g: FacetGeometry, shadowing: bool | str, q: Quadrature) -> torch.Tensor:
+    """D of Eq. 5/7 (closed form), or D_Q of the correlated masking on the emissivity's own nodes."""
+    if shadowing == "correlated":
+        return masked_denominator(g, q.outer, q.width)
+    return denominator(g, shadowing)
 
 
 def _work_dtype(dtype: torch.dtype, shadowing: bool) -> torch.dtype:
@@ -417,7 +437,7 @@ def apparent_radiance(
     refractive_index: Any = 1.218 + 0.0508j,
     sea_radiance: Any = None,
     sky: Any = None,
-    shadowing: bool = True,
+    shadowing: bool | str = True,
     quadrature: Quadrature | None = None,
     sun: Any = None,
     sun_masking: bool = True,
@@ -437,7 +457,8 @@ def apparent_radiance(
         sea_radiance: R_B, blackbody radiance at the sea temperature [W m⁻² sr⁻¹], ≥ 0.
         sky: R_s(θ'): a callable of cos(zenith), a (zenith [rad], radiance) table, a
             :class:`~roughsea_torch.sky.TabulatedSky`, a constant, or a named atmosphere.
-        shadowing: Eq. 5 (True, default) or Eq. 7.
+        shadowing: Eq. 5 (True, default), Eq. 7 (False), or "correlated" (Eq. 5 with the
+            slope-conditioned masking of :mod:`roughsea_torch.masking`; the sun's glint keeps Eq. 5).
         quadrature: accuracy control; ``Quadrature.default(dtype)`` when None.
         sun: ``None`` (default: no sun, every result as without it) or a
             :class:`~roughsea_torch.sun.Sun`: its reflection off the waves (the glint,
@@ -470,7 +491,8 @@ def apparent_radiance(
     if sun is not None:
         if not isinstance(sun, Sun):
             raise ValueError(f"sun must be None or a roughsea_torch.Sun; got {type(sun).__name__}")
-        out = out + glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun, shadowing, sun_masking)
+        out = out + glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun, bool(shadowing),
+                                   sun_masking)  # the glint keeps Eq. 5's weight with "correlated" (docs/shadowing.md)
     if foam_fraction is not None:
         check_finite_range("foam_fraction", foam_fraction, 0.0, 1.0)
         e_sky = foam_sky_radiance(as_sky(sky), LWIR, refractive_index, dtype=out.dtype, device=out.device)
@@ -486,7 +508,7 @@ def reflection_terms(
     slopes: SlopeStatistics,
     refractive_index: Any = 1.218 + 0.0508j,
     sky: Any = None,
-    shadowing: bool = True,
+    shadowing: bool | str = True,
     quadrature: Quadrature | None = None,
     *,
     sky_masking: bool = False,
@@ -527,6 +549,7 @@ def _reflection_integrals(
 ) -> tuple[torch.Tensor, torch.Tensor, torch.dtype]:
     """(T_s, T_ρ) in the working dtype (:func:`_work_dtype`), and the call's dtype; the tensors among
     ``extra_tensors`` (``apparent_radiance``'s sea radiance) join the dtype and device resolution."""
+    shadowing = check_shadowing(shadowing)
     sky_fn = as_sky(sky)
     sky_tensor = sky_fn.radiance if isinstance(sky_fn, (TabulatedSky, ConstantSky)) else None
     extra = {k: v for k, v in (extra_tensors or {}).items() if isinstance(v, torch.Tensor)}
@@ -545,8 +568,8 @@ def _reflection_integrals(
     if g.ct.numel() == 0:
         z = torch.zeros(shape, dtype=work, device=device)
         return z, z, dtype
-    D = denominator(g, shadowing)
+    D = _denominator(g, shadowing, q)
     nf, kf = n.expand(shape).reshape(-1), k.expand(shape).reshape(-1)
-    t_s, t_rho = _sky_terms(g, nf, kf, sky_fn, shape, D, q, sky_masking)
+    t_s, t_rho = _sky_terms(g, nf, kf, sky_fn, shape, D, q, sky_masking, shadowing)
     return t_s.reshape(shape), t_rho.reshape(shape), dtype
 

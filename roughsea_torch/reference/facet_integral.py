@@ -120,13 +120,14 @@ class FacetIntegral:
     """
 
     def __init__(self, theta_hat, phi_hat, a, b, r, shadowing, kind,
-                 m=None, sea_radiance=None, sky=None, mean=(0.0, 0.0)):
+                 m=None, sea_radiance=None, sky=None, mean=(0.0, 0.0), weight=None):
         self.th = float(theta_hat)
         self.ph = float(phi_hat)
         self.ct = math.cos(self.th)
         self.st = math.sin(self.th)
         self.a, self.b, self.r = float(a), float(b), float(r)
         self.shadowing = bool(shadowing)
+        self.weight = weight  # None, or a factor of the slope along the view (masking.masking_curve)
         self.kind = kind
         self.m = m
         self.R_B = None if sea_radiance is None else float(sea_radiance)
@@ -174,6 +175,8 @@ class FacetIntegral:
         if self.shadowing and not cos_omega > 0.0:  # H(pi/2 - Omega), Eq. 5
             return 0.0
         w = self.density(theta, phi) * cos_omega / cos_theta  # Eq. 3 / 5 numerator
+        if self.weight is not None:  # slope-conditioned masking; s_par = tan(theta) cos(phi - ph)
+            w *= self.weight(math.tan(theta) * math.cos(phi - self.ph))
         if self.kind == "area":
             return w
         rho = fresnel_scalar(abs(cos_omega), self.m)

@@ -47,6 +47,7 @@ from scipy import integrate
 
 from .facet_integral import HALF_PI, TWO_PI, FacetIntegral, SkyRadiance, unique_mod_2pi
 from .fresnel import as_complex_index, fresnel_scalar
+from .masking import masking_curve
 from .slopes import check_slope_arrays
 
 __all__ = ["projected_area", "emissivity", "apparent_radiance"]
@@ -106,10 +107,34 @@ def _tilted_flat_facet(th, ph, mean):
     return w, cos_omega, 2.0 * cos_omega * cos_theta - math.cos(th)
 
 
+def correlated_weight(shadowing, th, ph, a, b, r, mean=(0.0, 0.0)):
+    """None, or with shadowing="correlated" the masking factor Q(s_par) of this view and slope law
+    (reference.masking.masking_curve at nu = cot(th) / sigma_par; zero-mean laws only)."""
+    if not (isinstance(shadowing, str) and shadowing == "correlated"):
+        return None
+    if is_shifted(mean):
+        raise NotImplementedError("shadowing='correlated' in the reference needs slope_mean = (0, 0)")
+    c, s = math.cos(ph), math.sin(ph)
+    sig = math.sqrt(max(a * a * c * c + 2.0 * r * a * b * c * s + b * b * s * s, 0.0))
+    if not sig > 0.0:  # no slope along the view: nothing to condition on, Eq. 5
+        return None
+    return masking_curve(math.cos(th) / max(math.sin(th), 1e-300) / sig, sig)
+
+
+def check_shadowing(shadowing):
+    """True, False or "correlated", else ValueError."""
+    if isinstance(shadowing, str) and shadowing == "correlated":
+        return shadowing
+    if isinstance(shadowing, (bool, np.bool_)):
+        return bool(shadowing)
+    raise ValueError(f"shadowing must be True, False or 'correlated'; got {shadowing!r}")
+
+
 def numerator(kind, th, ph, a, b, r, shadowing, m=None, sea_radiance=None, sky=None,
                epsrel=1e-10, method="phi_outer", mean=(0.0, 0.0), epsabs=0.0):
     """Unnormalized integral of p cos(Omega)/cos(theta) [H] g over theta, phi (one scalar case)."""
-    fi = FacetIntegral(th, ph, a, b, r, shadowing, kind, m, sea_radiance, sky, mean)
+    fi = FacetIntegral(th, ph, a, b, r, shadowing, kind, m, sea_radiance, sky, mean,
+                       weight=correlated_weight(shadowing, th, ph, a, b, r, mean))
     return fi.integral(epsrel, method, epsabs)
 
 
@@ -129,7 +154,7 @@ def denominator(th, ph, a, b, r, shadowing, epsrel, method, mean=(0.0, 0.0)):
     """D of Eq. 5 by quadrature (shadowing) or, without shadowing, the exact Eq. 4 denominator:
     cos(th) (Eq. 7), cos th + sin th (mu . (cos ph, sin ph)) with a slope mean."""
     if shadowing:
-        return _projected_area_scalar(th, ph, a, b, r, True, epsrel, method, mean)
+        return _projected_area_scalar(th, ph, a, b, r, shadowing, epsrel, method, mean)
     if is_shifted(mean):
         return mean_facet_weight(th, ph, mean)
     return math.cos(th)
@@ -169,6 +194,9 @@ def projected_area(view_zenith, view_azimuth, slopes, shadowing=True, *, epsrel=
     With shadowing=False and th = pi/2 exactly the (zero-mean) integral is 0 (cos(pi/2)); it is
     computed with an absolute tolerance of 1e-15 there.
     """
+    if check_shadowing(shadowing) == "correlated":
+        raise ValueError("projected_area: shadowing must be True or False")
+    shadowing = check_shadowing(shadowing)
     th, ph = check_view(view_zenith, view_azimuth)
     a, b, r = slope_arrays(slopes)
     mx, my = check_slope_mean(slope_mean)
@@ -217,6 +245,7 @@ def emissivity(view_zenith, view_azimuth, slopes, refractive_index, shadowing=Tr
     shadowing where no facet in the density support faces the sensor, the result is NaN (0/0).
     Flat sea with a mean: the one facet of slope mu, 1 - rho(|cos Omega_mu|) (NaN if it is hidden).
     """
+    shadowing = check_shadowing(shadowing)
     th, ph = check_view(view_zenith, view_azimuth)
     a, b, r = slope_arrays(slopes)
     m = as_complex_index(refractive_index)
@@ -271,6 +300,7 @@ def apparent_radiance(view_zenith, view_azimuth, slopes, refractive_index, sea_r
     zenith angle of the reflected ray whatever mu is. Flat sea with a mean: the one facet of slope mu,
     (1 - rho) R_B + rho R_s(theta'_mu) (R_B if theta'_mu is below the horizontal; NaN if hidden).
     """
+    shadowing = check_shadowing(shadowing)
     th, ph = check_view(view_zenith, view_azimuth)
     a, b, r = slope_arrays(slopes)
     m = as_complex_index(refractive_index)

@@ -18,6 +18,7 @@ from .._validation import check_finite_range, parse_seeds, per_batch
 from ..atmosphere import as_sky, available_atmospheres, load_observer_sky, load_path, load_sky, surface_air_temperature
 from ..daysky import AEROSOLS, load_scattered_sky
 from ..foam import whitecap_fraction
+from ..masking import check_shadowing
 from ..optics import band_index_lookup, split_refractive_index
 from ..radiometry import LWIR, SpectralBand, as_band, band_radiance, brightness_temperature
 from ..slopes import MAX_WIND_SPEED, SlopeStatistics
@@ -121,7 +122,9 @@ class SeaScene:
             of a shipped LOWTRAN7 atmosphere (``"midlatitude_summer"``, the default).
         refractive_index: sea index n + i k; default: water (Hale & Querry) averaged over the band
             with Planck(T_sea) × response weights (the paper's choice).
-        shadowing: Eq. 5 (True) or Eq. 7.
+        shadowing: Eq. 5 (True, default), Eq. 7 (False), or "correlated": Eq. 5 with the slope-conditioned
+            masking of :mod:`roughsea_torch.masking` (emission and reflected sky; the sun's glint keeps
+            Eq. 5). Anything else is a ``ValueError``.
         path: the air between sea and sensor: radiance at the sensor = τ · R_a + L_path per sea pixel,
             from its slant range and the camera's altitude (``roughsea_torch.atmosphere.load_path``;
             a camera outside the tables' 2 m – 5 km is a ``ValueError`` at render time; ranges
@@ -208,7 +211,7 @@ class SeaScene:
         response: Any = None,
         sky: Any = "midlatitude_summer",
         refractive_index: Any = None,
-        shadowing: bool = True,
+        shadowing: bool | str = True,
         path: Any = None,
         air_temperature: Any = None,
         seed: Any = None,
@@ -266,7 +269,7 @@ class SeaScene:
             self._atmosphere_air_temperature = surface_air_temperature(self.atmosphere)
         self.air_temperature = air_temperature
         self.refractive_index = refractive_index
-        self.shadowing = shadowing
+        self.shadowing = check_shadowing(shadowing)
         if seed is not None:
             if wind_speed is None:
                 raise ValueError("seed: a textured sea needs wind_speed= (the wave spectrum is driven by the wind); "
