@@ -12,7 +12,8 @@ import torch
 import roughsea_torch as rs
 from roughsea_torch.foam import crest_foam_fraction, whitecap_fraction
 from roughsea_torch.waves import WaveField
-from roughsea_torch.whitecaps import DEPOSIT_INTERVAL_S, RESIDUAL_DECAY_S, active_share, deposit_epochs, whitecap_cover
+from roughsea_torch.whitecaps import (DEPOSIT_INTERVAL_S, RESIDUAL_DECAY_S, TRAILS_FROM, TRAILS_FULL, active_share,
+                                     deposit_epochs, whitecap_cover)
 
 from conftest import make_cams
 
@@ -78,6 +79,48 @@ def test_residual_foam_persists(storm):
     corr = lambda a, b: float(((a - a.mean()) * (b - b.mean())).mean() / (a.std() * b.std()))  # noqa: E731
     old = [crest_foam_fraction(c, wf.crest_variance(fp), wf.crest_variance()[:, None], w) for c in (c0, c1)]
     assert corr(fa0 + fr0, fa1 + fr1) > corr(*old) + 0.08
+
+
+def test_rare_whitecaps_leave_no_trails_and_the_blend_is_continuous(storm):
+    """Below TRAILS_FROM (W = 0.1 %) the residual foam is the breaking now: f_res = (1 − a) B and
+    f_act = a B exactly, B the instantaneous crest cover (crest_foam_fraction, computed here); from
+    TRAILS_FULL the residual is the trails' (1 s later it still correlates with now, unlike B); in
+    between the residual is the smoothstep blend of the two (halfway in W: their mean, per point, the
+    trails summed here from the deposit epochs and weights). Planted: the gate's share left at 1
+    (trails at every W) fails the first check."""
+    wf, x, y, _ = storm
+    fp = torch.full_like(x, 2.0)
+    a = active_share(wf.wind_speed, wf.inverse_wave_age)[:, None]
+    lo = 0.5 * TRAILS_FROM
+    fa, fr, c = _cover(wf, x, y, 3.3, fp, lo)
+    b = crest_foam_fraction(c, wf.crest_variance(fp), wf.crest_variance()[:, None], lo)
+    torch.testing.assert_close(fa, a * b, rtol=1e-12, atol=1e-15)
+    torch.testing.assert_close(fr, (1 - a) * b, rtol=1e-12, atol=1e-15)
+    hi, mid = TRAILS_FULL, 0.5 * (TRAILS_FROM + TRAILS_FULL)
+    _, fr_hi, _ = _cover(wf, x, y, 3.3, fp, hi)
+    b_hi = crest_foam_fraction(c, wf.crest_variance(fp), wf.crest_variance()[:, None], hi)
+    assert float((fr_hi - (1 - a) * b_hi).abs().max()) > 0.05  # the trails differ from the breaking now
+    _, fr_mid, _ = _cover(wf, x, y, 3.3, fp, mid)
+    b_mid = crest_foam_fraction(c, wf.crest_variance(fp), wf.crest_variance()[:, None], mid)
+    assert float(fr_mid.sum()) > 0 and bool(torch.isfinite(fr_mid).all())
+    # halfway the residual is the smoothstep (here 1/2) blend of the breaking now and the trails at that W
+    with_trails = _residual_with_trails(wf, x, y, 3.3, fp, mid)
+    torch.testing.assert_close(fr_mid, (1 - a) * 0.5 * (b_mid + with_trails), rtol=1e-10, atol=1e-14)
+
+
+def _residual_with_trails(wf, x, y, t, fp, w):
+    """R (the trails alone) at W, from the deposit epochs and weights (module docstring's sum)."""
+    from roughsea_torch.whitecaps import foam_drift
+
+    t = torch.full((x.shape[0],), t, dtype=D)
+    epochs, weights = deposit_epochs(t)
+    vx, vy = (v[:, None] for v in foam_drift(wf.wind_speed, wf.wind_direction))
+    r = torch.zeros_like(x)
+    for j in range(epochs.shape[1]):
+        age = (t - epochs[:, j])[:, None]
+        c = wf.sample_unchecked(x - vx * age, y - vy * age, epochs[:, j], fp, False, True)["crest"]
+        r = r + weights[:, j][:, None] * crest_foam_fraction(c, wf.crest_variance(fp), wf.crest_variance()[:, None], w)
+    return r
 
 
 def test_textured_storm_ensemble_mean_is_the_expectation_with_foam():
