@@ -2,7 +2,8 @@
 
 Writes ``storm_clip.png`` to ``--out``: one row per wind, one column per frame (0 to 3 s), LWIR
 brightness temperature of one realization (``SeaScene(seed=...)``, whitecaps on by default: active
-on the crests, residual foam decaying over ~2 s and drifting downwind, ``roughsea_torch.whitecaps``),
+on the crests; with ``TableSize(foam_trails=True)``, as here, residual foam decaying over ~2 s and
+drifting downwind, ``roughsea_torch.whitecaps``),
 a camera 15 m above the sea looking 8° down (ranges 60 m to the horizon), midlatitude-summer sky and path;
 one colour range per row (0.5–99.5 % of its frames' sea pixels). A last column shows the foam alone
 at the last frame (foam minus the same frame rendered with ``foam=False``).
@@ -24,6 +25,8 @@ import torch  # noqa: E402
 
 import roughsea_torch as rs  # noqa: E402
 
+TRAILS = rs.TableSize(foam_trails=True)  # the residual foam of the last seconds (default: the breaking now)
+
 TIMES = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0)
 WINDS = (15.0, 20.0, 25.0)
 
@@ -42,9 +45,9 @@ def main() -> None:
                              constrained_layout=True)
     for r, wind in enumerate(WINDS):
         frames = [rs.render(cams, rs.SeaScene(wind_speed=wind, sea_temperature=290.0, seed=11, time_s=t),
-                            output="brightness_temperature")[0, 0] for t in TIMES]
+                            output="brightness_temperature", table=TRAILS)[0, 0] for t in TIMES]
         bare = rs.render(cams, rs.SeaScene(wind_speed=wind, sea_temperature=290.0, seed=11, time_s=TIMES[-1], foam=False),
-                         output="brightness_temperature")[0, 0]
+                         output="brightness_temperature", table=TRAILS)[0, 0]
         v = torch.cat([f[sea] for f in frames])
         lo, hi = float(v.quantile(0.005)), float(v.quantile(0.995))
         for c, (t, f) in enumerate(zip(TIMES, frames)):

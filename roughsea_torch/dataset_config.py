@@ -44,7 +44,7 @@ DEFAULT_CONFIG: dict[str, Any] = {
     "motion": {name: list(d) for name, _a, _u, d in MOTION_FIELDS},
     # how textured seas are rendered (TableSize fields): the flat point or the sweep near grazing,
     # the column filter, MWIR glitter by day
-    "render": {"texture_hit": "flat", "texture_antialias": True, "glitter": False},
+    "render": {"texture_hit": "flat", "texture_antialias": True, "glitter": False, "foam_trails": False},
     "sensor": {
         "blur": {"sigma_px": 0.7},
         "noise": {"netd_k": 0.05},
@@ -106,8 +106,8 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
     ``motion`` table (ranges of the platform's oscillations for clips, keys of
     :data:`~roughsea_torch.sampling.MOTION_FIELDS`: amplitudes [deg], [m], periods [s]). The
     ``render`` table: ``texture_hit`` (``"flat"``, default, or ``"first"``: the sweep near grazing,
-    about 10× the time), ``texture_antialias`` (default true) and ``glitter`` (default false: MWIR
-    glitter by day), the :class:`~roughsea_torch.renderer.TableSize` fields of the same names.
+    about 10× the time), ``texture_antialias`` (default true), ``glitter`` (default false: MWIR
+    glitter by day) and ``foam_trails`` (default false: residual foam drifting and fading), the :class:`~roughsea_torch.renderer.TableSize` fields of the same names.
     Day images: ``scene.daytime`` (probability in [0, 1] that an item is by day, default 0.0: all
     by night, no sun drawn), ``scene.sun_elevation_deg`` (range [deg] within [0, 90], default
     [2, 60]), ``scene.sun_azimuth_deg`` (range [deg], default [-180, 180]; relative to the camera's
@@ -184,7 +184,7 @@ def _resolve_render(config: dict[str, Any], cfg: dict[str, Any]) -> None:
         raise ValueError(f"config: render must be a table of TableSize settings; got {render!r}")
     _check_keys("render.", render, set(DEFAULT_CONFIG["render"]))
     cfg["render"].update(render)
-    for key in ("texture_antialias", "glitter"):
+    for key in ("texture_antialias", "glitter", "foam_trails"):
         if not isinstance(cfg["render"][key], bool):
             raise ValueError(f"config: render.{key} must be true or false; got {cfg['render'][key]!r}")
     try:

@@ -139,7 +139,8 @@ def deposit_epochs(time_s: torch.Tensor, decay_s: float = RESIDUAL_DECAY_S, inte
 
 def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tensor, footprint: torch.Tensor | None,
                    crest_now: torch.Tensor, resolved_variance: torch.Tensor, total_variance: torch.Tensor,
-                   whitecap_fraction: torch.Tensor, decay_s: float = RESIDUAL_DECAY_S) -> tuple[torch.Tensor, torch.Tensor]:
+                   whitecap_fraction: torch.Tensor, decay_s: float = RESIDUAL_DECAY_S,
+                   trails: bool = True) -> tuple[torch.Tensor, torch.Tensor]:
     """The active and residual foam cover (a B, (1 − a) R) of points of a wave field (module docstring).
 
     Args:
@@ -151,6 +152,8 @@ def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tens
         resolved_variance: σ_r² of X_r at the footprint, broadcasting with x; total_variance: σ_X²,
             broadcasting; whitecap_fraction: W, broadcasting (e.g. (B, 1, ...)).
         decay_s: τ_R [s].
+        trails: False: the residual is the breaking now, R = B, at every W (no deposits read; the
+            renderer's default, ``TableSize.foam_trails``).
 
     Returns:
         (f_active, f_residual), x's shape, each in [0, 1], f_active + f_residual in [0, 1], with
@@ -168,7 +171,7 @@ def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tens
     now = indicator(crest_now)
     t = ((whitecap_fraction - TRAILS_FROM) / (TRAILS_FULL - TRAILS_FROM)).clamp(0.0, 1.0)
     share = t * t * (3.0 - 2.0 * t)  # of the trails in the residual (TRAILS_FROM, TRAILS_FULL above)
-    if not bool((share > 0).any()):  # no image draws trails: the residual is the breaking now
+    if not trails or not bool((share > 0).any()):  # no trails drawn: the residual is the breaking now
         return a * now, (1.0 - a) * now
     residual = torch.zeros_like(crest_now)
     for j in range(epochs.shape[1]):

@@ -131,7 +131,7 @@ def test_textured_storm_ensemble_mean_is_the_expectation_with_foam():
     2.2e-3 and 4.0e-3 with foam, 9e-4 without)."""
     cams = make_cams(24, 32, pitch_deg=-8.0, batch_size=16, hfov_deg=20.0, altitude_m=15.0)
     kw = dict(wind_speed=20.0, sea_temperature=290.0, path=False)
-    tex = rs.render(cams, rs.SeaScene(**kw, seed=list(range(16)), time_s=2.3))
+    tex = rs.render(cams, rs.SeaScene(**kw, seed=list(range(16)), time_s=2.3), table=rs.TableSize(foam_trails=True))
     mean = rs.render(cams, rs.SeaScene(**kw))
     sea = rs.view_geometry(cams).is_sea[:, None]
     assert abs(float(((tex - mean) * sea).sum() / (mean * sea).sum())) < 1e-3

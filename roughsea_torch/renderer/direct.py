@@ -35,7 +35,8 @@ __all__ = ["render_direct", "sea_direct", "sea_textured_direct"]
 
 
 def render_direct(cameras: PinholeCamera, geometry: ViewGeometry | None, scene: SeaScene, p: SceneParameters,
-                  q: Quadrature, earth_radius_m: float, brightness: bool, antialias: bool = True) -> torch.Tensor:
+                  q: Quadrature, earth_radius_m: float, brightness: bool, antialias: bool = True,
+                  foam_trails: bool = False) -> torch.Tensor:
     """Every pixel of the cameras' images, (B, 1, H, W); in kelvin with ``brightness``; a textured
     sea's texture filtered along the columns with ``antialias`` (:mod:`~roughsea_torch.renderer.antialias`)."""
     geom = geometry if geometry is not None else view_geometry(cameras, earth_radius_m)
@@ -51,7 +52,7 @@ def render_direct(cameras: PinholeCamera, geometry: ViewGeometry | None, scene: 
                                                                    * p.air_scale[:, None]),
                                         air_scale=None)  # the sky itself now carries it
         img = (sea_direct(geom, p_sea, scene, q, B, dtype, device) if scene.seed is None
-               else sea_textured_direct(geom, cameras, p_sea, scene, q, B, dtype, device, antialias))
+               else sea_textured_direct(geom, cameras, p_sea, scene, q, B, dtype, device, antialias, foam_trails))
         if scene.path is not None:
             check_path_altitude(scene.path, altitude)
             img = apply_path(scene.path, img, altitude, geom.range_m, sea, p.air_scale)
@@ -101,7 +102,7 @@ def sea_direct(geom: ViewGeometry, p: SceneParameters, scene: SeaScene, q: Quadr
 
 def sea_textured_direct(geom: ViewGeometry, cameras: PinholeCamera, p: SceneParameters, scene: SeaScene,
                          q: Quadrature, B: int, dtype: torch.dtype, device: torch.device,
-                         antialias: bool = True) -> torch.Tensor:
+                         antialias: bool = True, foam_trails: bool = False) -> torch.Tensor:
     """The textured sea per pixel (the baseline of the texture volume): each sea pixel's own
     footprint, resolved slope, visible slope a' and shifted expectation (:mod:`roughsea_torch.clutter`);
     with ``antialias`` its departure from the expectation (Eq. 10 at the pixel) and its crest-foam
@@ -144,7 +145,8 @@ def sea_textured_direct(geom: ViewGeometry, cameras: PinholeCamera, p: ScenePara
         vals = vals + g
     if p.foam is not None:  # whitecaps on the crests and their residual foam (whitecaps.whitecap_cover)
         f_act, f_res = whitecap_cover(wf, xw, yw, time, L, smp["crest"], wf.crest_variance(L),
-                                      wf.crest_variance()[:, None, None], p.foam.to(dtype)[:, None, None])
+                                      wf.crest_variance()[:, None, None], p.foam.to(dtype)[:, None, None],
+                                      trails=foam_trails)
         f = f_act + f_res
         if antialias:
             f = antialias_texture(torch.zeros_like(f), torch.where(sea, f, torch.zeros_like(f)), sea)[1]

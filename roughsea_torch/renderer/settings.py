@@ -95,6 +95,13 @@ class TableSize:
             one-pixel horizontal lines; the ensemble mean is unchanged); False: unfiltered. Both
             methods; the sweep is not filtered.
 
+    The whitecaps of textured seas (:mod:`roughsea_torch.whitecaps`):
+
+        foam_trails: ``False`` (default): the residual foam sits where the crests break now (the
+            whitecap cover of one instant, E[f] = W); ``True``: it is the breaking of the last seconds,
+            drifting and fading (trails; 13 more reads of the wave field per pixel, 2–5× a textured
+            storm's time). Both methods.
+
     The glint of textured seas (:mod:`roughsea_torch.glitter`, ``docs/glitter.md``):
 
     Args:
@@ -145,6 +152,7 @@ class TableSize:
     glint_tolerance: float = 1e-5
     glitter: bool = False
     glitter_lifetime_s: float = 0.25
+    foam_trails: bool = False
 
     def __post_init__(self) -> None:
         if self.span not in ("pixels", "full"):
@@ -175,6 +183,8 @@ class TableSize:
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real) or not lo <= float(v) <= hi:
                 raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")
             object.__setattr__(self, name, float(v))
+        if not isinstance(self.foam_trails, (bool, np.bool_)):
+            raise ValueError(f"TableSize.foam_trails must be a bool; got {self.foam_trails!r}")
         if not isinstance(self.glitter, (bool, np.bool_)):
             raise ValueError(f"TableSize.glitter must be a bool; got {self.glitter!r}")
         tau = self.glitter_lifetime_s

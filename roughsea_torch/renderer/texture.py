@@ -90,6 +90,7 @@ class TextureTable:
         self.window = float(table.texture_quadrature_width)
         self.min_band_share = float(table.texture_min_band_share)
         self.first_hit = table.texture_hit == "first"
+        self.foam_trails = bool(table.foam_trails)
         self.antialias = bool(table.texture_antialias)  # (renderer.antialias; the sweep is not filtered)
         # the sweep (TableSize.texture_hit_*): samples s(θ̂) pixels apart in depression, each filtered at
         # twice its spacing's footprint along the view, and the volume built for those footprints
@@ -286,7 +287,7 @@ class TextureTable:
             zero = torch.zeros_like(out)
             f_act, f_res = whitecap_cover(wf, X, Y, self.time[sl], L, torch.where(sea, smp["crest"], zero),
                                           torch.where(sea, cov[:, 3], zero), wf.crest_variance()[:, None, None],
-                                          self.p.foam[sl].to(dtype)[:, None, None])
+                                          self.p.foam[sl].to(dtype)[:, None, None], trails=self.foam_trails)
             f_pix = torch.where(sea, f_act + f_res, zero)
         out = torch.where(sea, out, torch.zeros_like(out))
         if self.antialias:  # the band at the rows' Nyquist folds into one-pixel lines (renderer.antialias)
@@ -357,7 +358,7 @@ class TextureTable:
             var_r = wf.crest_variance(sw.footprint[None])[:, :, None].expand(1, ns, nt).reshape(1, -1)
             f_act, f_res = whitecap_cover(wf, sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1], fp,
                                           smp["crest"], var_r, wf.crest_variance()[:, None],
-                                          self.p.foam[im:im + 1].to(dtype)[:, None])
+                                          self.p.foam[im:im + 1].to(dtype)[:, None], trails=self.foam_trails)
             values.append((f_act + f_res)[0].reshape(ns, nt))
         return torch.stack([v.T for v in values]), x_k, cov_k, m
 

@@ -96,3 +96,18 @@ def test_foam_by_day_also_reflects_the_scattered_sky():
     rb = rs.band_radiance(torch.tensor(290.0, dtype=torch.float64), rs.MWIR)
     want = foam_radiance(g.view_zenith[0], rs.MWIR, rb, e_day + e_thermal, refractive_index=(m.real, m.imag))
     torch.testing.assert_close(r_foam, want, rtol=1e-6, atol=0)
+
+
+def test_foam_trails_reach_both_methods():
+    """TableSize(foam_trails=True) draws the residual foam of the last seconds (whitecaps.whitecap_cover's
+    trails): a 15 m/s storm differs from the default (the breaking now) by over 0.05 K somewhere, and the
+    table render with trails equals the per-pixel one with trails to 2 % of the foam's own change."""
+    cams = make_cams(24, 32, hfov_deg=20.0, altitude_m=15.0, pitch_deg=-8.0)
+    scene = rs.SeaScene(wind_speed=15.0, sea_temperature=290.0, seed=[4], time_s=2.3, path=False)
+    trails = rs.TableSize(foam_trails=True)
+    kw = dict(output="brightness_temperature")
+    now, with_trails = rs.render(cams, scene, **kw), rs.render(cams, scene, table=trails, **kw)
+    change = float((with_trails - now).abs().max())
+    assert change > 0.05
+    direct = rs.render(cams, scene, method="direct", table=trails, **kw)
+    assert float((with_trails - direct).abs().max()) < 0.02 * change + 2e-3

@@ -362,7 +362,7 @@ def test_texture_table_returns_the_pixels_crest(monkeypatch):
     xw, yw = centres[:, 0, None, None] + R * geom.dx, centres[:, 1, None, None] + R * geom.dy
     s = field.sample(xw, yw, times, footprint=L, elevation=False, crest=True)
     f_act, f_res = whitecap_cover(field, xw, yw, times, L, s["crest"], field.crest_variance(L),
-                                  field.crest_variance()[:, None, None], w)
+                                  field.crest_variance()[:, None, None], w, trails=False)  # TableSize.foam_trails
     direct = f_act + f_res
     direct = filter_columns(torch.where(sea, direct, torch.zeros_like(direct)), sea)  # the default TableSize.texture_antialias (FOAM_TAPS)
     assert float((f_pix - direct)[sea].abs().max()) < 2e-3
