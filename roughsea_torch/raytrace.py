@@ -307,7 +307,7 @@ def _unresolved_statistics(total: SlopeStatistics, traced_cov: torch.Tensor, win
     return u
 
 
-def raytraced_image(
+def raytraced_image(  # ~100 lines: 22 lines of signature, the docstring, then each stage a call (checks, march, finish)
     cameras: PinholeCamera,
     wind_speed: float,
     *,

@@ -248,7 +248,7 @@ def _bisect(gap: Callable[[torch.Tensor], torch.Tensor], lo: torch.Tensor, hi: t
     return 0.5 * (lo + hi)
 
 
-def march_first_hits(
+def march_first_hits(  # ~90 lines: the march loop (a safe step, the crossing test, the bisection's bracket) reads best whole
     centres: torch.Tensor,
     directions: torch.Tensor,
     surface: Surface,

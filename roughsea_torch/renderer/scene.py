@@ -198,7 +198,7 @@ class SeaScene:
         2
     """
 
-    def __init__(
+    def __init__(  # ~100 lines: the signature (26 keyword arguments) and one check or conversion per argument
         self,
         *,
         slopes: SlopeStatistics | None = None,
