@@ -420,6 +420,9 @@ class SeaScene:
         renderer asks for) are kept while the scene's wind, direction and seed are unchanged (their
         random amplitudes are drawn once)."""
         wind = per_batch("wind_speed", self.wind_speed, B, dtype, device)[sl]
+        if bool((wind.detach() == 0).any()):
+            raise ValueError("wind_speed: a textured sea (SeaScene(seed=...)) needs a wind above 0 m/s; a calm sea has "
+                             "no waves to draw: render it with seed=None (the expectation image)")
         wd = per_batch("wind_direction", self.wind_direction, B, dtype, device)[sl]
         seeds = self.seeds(B)[sl]
         share = TableSize.texture_min_band_share if min_band_share is None else float(min_band_share)

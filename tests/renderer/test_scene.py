@@ -318,6 +318,12 @@ def test_one_int_seed_gives_each_image_its_own_derived_seed():
     assert float((pair[1] - other[0]).abs().max()) > 1e-4
 
 
+def test_calm_textured_scene_says_to_drop_the_seed():
+    """wind 0 with seed=: the error names wind_speed and says seed=None (it named the WaveField)."""
+    with pytest.raises(ValueError, match=r"^wind_speed: .*seed=None"):
+        rs.render(make_cams(8, 8), make_scene(wind_speed=0.0, seed=1))
+
+
 def test_textured_scene_needs_wind_speed_and_valid_seed():
     with pytest.raises(ValueError, match="wind_speed"):
         rs.SeaScene(slopes=rs.SlopeStatistics.cox_munk(5.0), sea_temperature=290.0, seed=1)
