@@ -36,6 +36,17 @@ from bench_render import B, H, W, batch, med, peak_memory  # noqa: E402
 import roughsea_torch as rs  # noqa: E402
 
 
+def alternately(f, g, repeats: int) -> tuple[float, float]:
+    """The medians [s] of ``repeats`` timings of f and of g, run in turn (the machine's load falls on both)."""
+    tf, tg = [], []
+    for _ in range(repeats):
+        for fn, out in ((f, tf), (g, tg)):
+            t0 = time.perf_counter()
+            fn()
+            out.append(time.perf_counter() - t0)
+    return sorted(tf)[len(tf) // 2], sorted(tg)[len(tg) // 2]
+
+
 def scenes(b: int = B):
     cam, sc = batch(b)
     cams = rs.make_camera(H, W, **cam)
@@ -159,15 +170,8 @@ def main() -> None:
               "| threads | flat point [s] | sweep [s] | sweep / flat point |", "|---:|---:|---:|---:|"]
     for threads in (1, 2):
         torch.set_num_threads(threads)
-        t_flat, t_first = [], []
-        for _ in range(args.repeats):
-            t0 = time.perf_counter()
-            rs.render(cams, tex_scene)
-            t_flat.append(time.perf_counter() - t0)
-            t0 = time.perf_counter()
-            rs.render(cams, tex_scene, table=first)
-            t_first.append(time.perf_counter() - t0)
-        t_flat, t_first = sorted(t_flat)[len(t_flat) // 2], sorted(t_first)[len(t_first) // 2]
+        t_flat, t_first = alternately(lambda: rs.render(cams, tex_scene), lambda: rs.render(cams, tex_scene, table=first),
+                                      args.repeats)
         lines.append(f"| {threads} | {t_flat:.3f} | {t_first:.3f} | {t_first / t_flat:.2f} |")
         print(lines[-1], file=sys.stderr)
     # by day: the same batch with the sun 10° above the horizon straight ahead of each camera (its
@@ -188,15 +192,7 @@ def main() -> None:
     # the TableSize that brings textured MWIR glint pixels under the day sky's aureole from 7e-4 to 2.4e-4 of
     # per-pixel evaluation (tests/test_sun.py), against the default, timed alternately
     refined = rs.TableSize(texture_quadrature=(20, 16), texture_azimuth_sun=17, fine_texture_azimuth=64)
-    t_def, t_ref = [], []
-    for _ in range(args.repeats):
-        t0 = time.perf_counter()
-        rs.render(cams, day)
-        t_def.append(time.perf_counter() - t0)
-        t0 = time.perf_counter()
-        rs.render(cams, day, table=refined)
-        t_ref.append(time.perf_counter() - t0)
-    t_def, t_ref = sorted(t_def)[len(t_def) // 2], sorted(t_ref)[len(t_ref) // 2]
+    t_def, t_ref = alternately(lambda: rs.render(cams, day), lambda: rs.render(cams, day, table=refined), args.repeats)
     lines += ["", "Textured by day with the TableSize refined for the sun's aureole (`texture_quadrature=(20, 16), "
               "texture_azimuth_sun=17, fine_texture_azimuth=64`), against the default, timed alternately, 1 thread:", "",
               "| default [s] | refined [s] | refined / default |", "|---:|---:|---:|",

@@ -31,17 +31,15 @@ import torch
 import roughsea_torch as rs
 from roughsea_torch.waves import WaveBands, WaveField
 
+READS = "  of which wave-field reads (all stages)"
 STAGES = {  # (file suffix, function) → label
     ("renderer/table.py", "node_values"): "stage 1: model at the nodes (mean and texture)",
     ("renderer/table.py", "fine_table"): "stage 2: fine tables and texture volume",
     ("renderer/table.py", "per_pixel_terms"): "stage 4: per-pixel terms",
     ("renderer/texture.py", "pixels"): "  of which the texture's pixels",
-    ("waves.py", "sample_unchecked"): "  of which wave-field reads (all stages)",  # READS
+    ("waves.py", "sample_unchecked"): READS,
     ("renderer/hits.py", "visible_average"): "  of which the sweep's visible average",
 }
-
-
-READS = "  of which wave-field reads (all stages)"
 
 
 def stage_times(hit: str | None, repeats: int) -> tuple[float, dict[str, float]]:

@@ -184,9 +184,6 @@ def _resolve_render(config: dict[str, Any], cfg: dict[str, Any]) -> None:
         raise ValueError(f"config: render must be a table of TableSize settings; got {render!r}")
     _check_keys("render.", render, set(DEFAULT_CONFIG["render"]))
     cfg["render"].update(render)
-    for key in ("texture_antialias", "glitter", "foam_trails"):
-        if not isinstance(cfg["render"][key], bool):
-            raise ValueError(f"config: render.{key} must be true or false; got {cfg['render'][key]!r}")
     try:
         config_table(cfg)
     except ValueError as e:

@@ -39,7 +39,7 @@ from __future__ import annotations
 import torch
 import torch.nn.functional as F
 
-__all__ = ["TEXTURE_TAPS", "FOAM_TAPS", "filter_columns", "antialias_texture"]
+__all__ = ["TEXTURE_TAPS", "FOAM_TAPS", "filter_columns"]
 
 TEXTURE_TAPS = (-1.0 / 16, 4.0 / 16, 10.0 / 16, 4.0 / 16, -1.0 / 16)  # Δ: zero at the Nyquist frequency
 FOAM_TAPS = (0.25, 0.5, 0.25)  # the crest-foam fraction: positive weights, zero at the Nyquist frequency
@@ -54,7 +54,7 @@ def _shifted(t: torch.Tensor, k: int) -> torch.Tensor:
     return F.pad(t[:, -k:], (0, 0, 0, -k))
 
 
-def filter_columns(values: torch.Tensor, sea: torch.Tensor, taps: tuple[float, ...] = FOAM_TAPS) -> torch.Tensor:
+def filter_columns(values: torch.Tensor, sea: torch.Tensor, taps: tuple[float, ...]) -> torch.Tensor:
     """The symmetric filter ``taps`` (odd length, centre tap largest) along the rows' direction (dim −2)
     of ``values`` (b, H, W), over the sea pixels ``sea`` (b, H, W) bool only: out = Σ_k t_k m v / Σ_k t_k m
     (weights renormalized where a neighbour is not sea); pixels outside ``sea`` are returned unchanged.
@@ -66,10 +66,3 @@ def filter_columns(values: torch.Tensor, sea: torch.Tensor, taps: tuple[float, .
     den = sum(t * _shifted(m, k - half) for k, t in enumerate(taps))
     return torch.where(sea, num / torch.where(sea, den, torch.ones_like(den)), values)
 
-
-def antialias_texture(delta: torch.Tensor, foam_fraction: torch.Tensor | None, sea: torch.Tensor
-                      ) -> tuple[torch.Tensor, torch.Tensor | None]:
-    """The texture's departure Δ (b, H, W) filtered with ``TEXTURE_TAPS`` and the crest-foam fraction
-    (b, H, W, or None) with ``FOAM_TAPS``, over the sea pixels ``sea``."""
-    delta = filter_columns(delta, sea, TEXTURE_TAPS)
-    return delta, None if foam_fraction is None else filter_columns(foam_fraction, sea, FOAM_TAPS)

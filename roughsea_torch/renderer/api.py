@@ -108,8 +108,7 @@ def _render(cameras: PinholeCamera, scene: SeaScene, *, earth_radius_m: float, m
     p = scene.resolved(B, dtype, device)
     q = quadrature or Quadrature.default(dtype)
     if method == "direct":
-        return render_direct(cameras, geometry, scene, p, q, earth_radius_m, brightness, table.texture_antialias,
-                             table.foam_trails)
+        return render_direct(cameras, geometry, scene, p, q, earth_radius_m, brightness, table)
     if geometry is not None:
         altitude, radius = geometry.altitude_m, getattr(geometry, "earth_radius_m", earth_radius_m)
     else:

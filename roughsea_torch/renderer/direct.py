@@ -23,22 +23,23 @@ from ..sky import select_sky
 from ..slopes import SlopeStatistics
 from ..sun import glint_radiance, sun_masking_factor
 from ..whitecaps import whitecap_cover
+from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
 from .foam_terms import foam_mix
 from .output import kelvin
 from .path import apply_path, check_path_altitude
 from .scene import SceneParameters, SeaScene
+from .settings import TableSize
 from .sky_terms import day_sky, day_sky_pixels, relative_sun, sky_rows, sky_with_day, sun_disk_pixels
-from .antialias import antialias_texture
 from .texture import single_quantile
 
 __all__ = ["render_direct", "sea_direct", "sea_textured_direct"]
 
 
 def render_direct(cameras: PinholeCamera, geometry: ViewGeometry | None, scene: SeaScene, p: SceneParameters,
-                  q: Quadrature, earth_radius_m: float, brightness: bool, antialias: bool = True,
-                  foam_trails: bool = False) -> torch.Tensor:
+                  q: Quadrature, earth_radius_m: float, brightness: bool, table: TableSize = TableSize()) -> torch.Tensor:
     """Every pixel of the cameras' images, (B, 1, H, W); in kelvin with ``brightness``; a textured
-    sea's texture filtered along the columns with ``antialias`` (:mod:`~roughsea_torch.renderer.antialias`)."""
+    sea's texture drawn with the ``table`` settings that apply per pixel (``texture_antialias``: the
+    filter along the columns, :mod:`~roughsea_torch.renderer.antialias`; ``foam_trails``)."""
     geom = geometry if geometry is not None else view_geometry(cameras, earth_radius_m)
     B, H, W = geom.is_sea.shape
     dtype, device = geom.cos_view_zenith.dtype, geom.cos_view_zenith.device
@@ -52,7 +53,7 @@ def render_direct(cameras: PinholeCamera, geometry: ViewGeometry | None, scene: 
                                                                    * p.air_scale[:, None]),
                                         air_scale=None)  # the sky itself now carries it
         img = (sea_direct(geom, p_sea, scene, q, B, dtype, device) if scene.seed is None
-               else sea_textured_direct(geom, cameras, p_sea, scene, q, B, dtype, device, antialias, foam_trails))
+               else sea_textured_direct(geom, cameras, p_sea, scene, q, B, dtype, device, table))
         if scene.path is not None:
             check_path_altitude(scene.path, altitude)
             img = apply_path(scene.path, img, altitude, geom.range_m, sea, p.air_scale)
@@ -102,11 +103,11 @@ def sea_direct(geom: ViewGeometry, p: SceneParameters, scene: SeaScene, q: Quadr
 
 def sea_textured_direct(geom: ViewGeometry, cameras: PinholeCamera, p: SceneParameters, scene: SeaScene,
                          q: Quadrature, B: int, dtype: torch.dtype, device: torch.device,
-                         antialias: bool = True, foam_trails: bool = False) -> torch.Tensor:
+                         table: TableSize = TableSize()) -> torch.Tensor:
     """The textured sea per pixel (the baseline of the texture volume): each sea pixel's own
     footprint, resolved slope, visible slope a' and shifted expectation (:mod:`roughsea_torch.clutter`);
-    with ``antialias`` its departure from the expectation (Eq. 10 at the pixel) and its crest-foam
-    fraction filtered along the columns (:func:`~roughsea_torch.renderer.antialias.antialias_texture`)."""
+    with ``table.texture_antialias`` its departure from the expectation (Eq. 10 at the pixel) and its crest-foam
+    fraction filtered along the columns (:func:`~roughsea_torch.renderer.antialias.filter_columns`)."""
     sea = geom.is_sea
     wf = scene.wave_field(B, dtype, device)
     centres = -(cameras.rotation_matrix.transpose(-1, -2) @ cameras.translation_vector)[..., 0].to(dtype)
@@ -131,12 +132,12 @@ def sea_textured_direct(geom: ViewGeometry, cameras: PinholeCamera, p: ScenePara
         sky = sky_with_day(sky, day, p, img_idx, ph)
     vals = apparent_radiance(th, ph, slopes, (p.n[img_idx], p.k[img_idx]), sea_radiance=p.rb[img_idx],
                              sky=sky, shadowing=scene.shadowing, quadrature=q, sky_masking=scene.sky_masking)
-    if antialias:  # the expectation plus the filtered departure (the table's texture volume holds the same)
+    if table.texture_antialias:  # the expectation plus the filtered departure (the table's texture volume holds the same)
         mean = apparent_radiance(th, ph, SlopeStatistics.from_variances(vx, vy, cxy), (p.n[img_idx], p.k[img_idx]),
                                  sea_radiance=p.rb[img_idx], sky=sky, shadowing=scene.shadowing, quadrature=q,
                                  sky_masking=scene.sky_masking)
         delta = torch.zeros(sea.shape, dtype=vals.dtype, device=vals.device).index_put((sea,), vals - mean)
-        vals = mean + antialias_texture(delta, None, sea)[0][sea]
+        vals = mean + filter_columns(delta, sea, TEXTURE_TAPS)[sea]
     sun = relative_sun(scene, p, B, dtype, device, img_idx)
     if sun is not None:  # the pixel's own glint, masked from the sun by the total law (sun_masking_factor)
         g = glint_radiance(th, ph, slopes, (p.n[img_idx], p.k[img_idx]), sun, scene.shadowing, False)
@@ -146,10 +147,10 @@ def sea_textured_direct(geom: ViewGeometry, cameras: PinholeCamera, p: ScenePara
     if p.foam is not None:  # whitecaps on the crests and their residual foam (whitecaps.whitecap_cover)
         f_act, f_res = whitecap_cover(wf, xw, yw, time, L, smp["crest"], wf.crest_variance(L),
                                       wf.crest_variance()[:, None, None], p.foam.to(dtype)[:, None, None],
-                                      trails=foam_trails)
+                                      trails=table.foam_trails)
         f = f_act + f_res
-        if antialias:
-            f = antialias_texture(torch.zeros_like(f), torch.where(sea, f, torch.zeros_like(f)), sea)[1]
+        if table.texture_antialias:
+            f = filter_columns(torch.where(sea, f, torch.zeros_like(f)), sea, FOAM_TAPS)
         vals = foam_mix(vals, th, p, img_idx, scene, f[sea])
     out = torch.zeros(sea.shape, dtype=vals.dtype, device=vals.device)
     return out.index_put((sea,), vals)

@@ -27,7 +27,7 @@ from ..geometry import slant_range
 from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
-from .antialias import antialias_texture
+from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
 from .hits import Sweep, centre_element, pixel_windows, sample_step, sweep_envelope, sweep_layout, visible_average
 from .path import path_rows
 from .scene import SceneParameters
@@ -291,7 +291,8 @@ class TextureTable:
             f_pix = torch.where(sea, f_act + f_res, zero)
         out = torch.where(sea, out, torch.zeros_like(out))
         if self.antialias:  # the band at the rows' Nyquist folds into one-pixel lines (renderer.antialias)
-            out, f_pix = antialias_texture(out, f_pix, sea)
+            out = filter_columns(out, sea, TEXTURE_TAPS)
+            f_pix = None if f_pix is None else filter_columns(f_pix, sea, FOAM_TAPS)
         # x (or, with a sun, the visible quantile x' read from channel 1) and the resolved covariance go
         # back too: the glint of the same realization needs them
         return (out, x if vol.shape[1] == 1 else (x, read[:, 1]),

@@ -38,10 +38,10 @@ def test_mask_edges_renormalize_and_leave_other_pixels_alone(dtype):
     constant, five taps too); gradients are finite and sum to 1 per output pixel."""
     v = torch.tensor([[5.0, 1.0, 2.0, 4.0, 8.0, 7.0]], dtype=dtype)[..., None].requires_grad_(True)
     sea = torch.tensor([[False, True, True, True, False, True]])[..., None]
-    out = filter_columns(v, sea)
+    out = filter_columns(v, sea, FOAM_TAPS)
     want = torch.tensor([5.0, (2 * 1 + 2) / 3, (1 + 4 + 4) / 4, (2 + 8) / 3, 8.0, 7.0], dtype=dtype)
     torch.testing.assert_close(out[0, :, 0], want)
-    const = filter_columns(torch.full((1, 6, 1), 3.5, dtype=dtype), sea)
+    const = filter_columns(torch.full((1, 6, 1), 3.5, dtype=dtype), sea, FOAM_TAPS)
     assert torch.equal(const, torch.full_like(const, 3.5))
     const5 = filter_columns(torch.full((1, 6, 1), 3.5, dtype=dtype), sea, TEXTURE_TAPS)
     torch.testing.assert_close(const5, torch.full_like(const5, 3.5))

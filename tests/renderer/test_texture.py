@@ -12,7 +12,7 @@ import pytest
 import torch
 
 import roughsea_torch as rs
-from roughsea_torch.renderer.antialias import filter_columns
+from roughsea_torch.renderer.antialias import FOAM_TAPS, filter_columns
 from roughsea_torch.clutter import footprint
 from roughsea_torch.renderer.texture import TextureTable
 from roughsea_torch.whitecaps import whitecap_cover
@@ -364,7 +364,7 @@ def test_texture_table_returns_the_pixels_crest(monkeypatch):
     f_act, f_res = whitecap_cover(field, xw, yw, times, L, s["crest"], field.crest_variance(L),
                                   field.crest_variance()[:, None, None], w, trails=False)  # TableSize.foam_trails
     direct = f_act + f_res
-    direct = filter_columns(torch.where(sea, direct, torch.zeros_like(direct)), sea)  # the default TableSize.texture_antialias (FOAM_TAPS)
+    direct = filter_columns(torch.where(sea, direct, torch.zeros_like(direct)), sea, FOAM_TAPS)  # TableSize.texture_antialias
     assert float((f_pix - direct)[sea].abs().max()) < 2e-3
     assert bool(((f_pix >= 0) & (f_pix <= 1)).all()) and bool((f_pix[~sea] == 0).all())
     assert float(f_pix[sea].max()) > 0.3  # foam present: the comparison covers the edges
