@@ -41,7 +41,7 @@ def main() -> None:
         clip = rs.render_clip(cam, scene, times, output="brightness_temperature", table=rs.TableSize(glitter=glitter))
         rows.append(clip[0])  # (T, 1, H, W)
     images = torch.cat(rows)
-    titles = [f"{'glitter' if g else 'expectation'}, t = {t:.2f} s" for g in (False, True) for t in times]
+    titles = [f"{'glitter' if g else 'smooth glint (default)'}, t = {t:.2f} s" for g in (False, True) for t in times]
     lo = float(torch.quantile(images.flatten().float(), 0.005))
     hi = float(torch.quantile(rows[0].flatten().float(), 0.999))  # the smooth path's top: glitter spots clip to white
     save_grid(images, titles, args.out / "glitter_clip.png", label="brightness temperature [K]", ncols=args.frames,
