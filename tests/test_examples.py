@@ -8,6 +8,8 @@ from pathlib import Path
 import pytest
 import torch
 
+import roughsea_torch as rs
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -32,3 +34,22 @@ def test_image_grids_share_one_robust_colour_range_by_default(tmp_path):
     own = save_grid(imgs, ["a", "b", "c"], tmp_path / "own.png", label="K", shared_scale=False)
     assert len(set(own)) == 3
 
+
+
+def test_main_job_metadata_holds_what_made_each_image(tmp_path):
+    """The README's main job (examples/render_default.py, run small): metadata.json holds, per image,
+    the air temperature (the atmosphere's surface air, from the LOWTRAN tables), the whitecap fraction
+    (Monahan's law at the image's wind) and its wave seed, and for the run the package version and
+    the table settings (they were missing: a new user's finding)."""
+    import json
+    import subprocess
+
+    subprocess.run([sys.executable, str(ROOT / "examples" / "render_default.py"), "--out", str(tmp_path),
+                    "--batch", "2", "--height", "24", "--width", "32"], check=True, capture_output=True)
+    meta = json.loads((tmp_path / "metadata.json").read_text())
+    assert meta["roughsea_torch"] == rs.__version__ and "texture_antialias" in meta["table"]
+    for img in meta["images"]:
+        assert img["air_temperature"] == rs.atmosphere.surface_air_temperature("midlatitude_summer")
+        w = float(rs.foam.whitecap_fraction(torch.tensor(img["wind_speed"], dtype=torch.float64)))
+        assert abs(img["whitecap_fraction"] - w) < 1e-6 * max(w, 1e-6)
+        assert isinstance(img["wave_seed"], int)
