@@ -1,11 +1,13 @@
 """Sun glitter in an MWIR daytime clip: the glint of a textured sea as the smooth expectation and as
-glitter (``TableSize(glitter=True)``, :mod:`roughsea_torch.glitter`).
+glitter (``TableSize(glitter=True)``, :mod:`roughsea_torch.glitter`), in the glint path and at its edge.
 
-Writes ``glitter_clip.png`` to ``--out``: a 10 m mast looking 6° down towards the sun, 15° above the
-horizon straight ahead, wind 8 m/s, MWIR (3–5 µm), E_sun = 12 W m⁻², a 640-pixel-wide camera with a
-30° field of view cropped to the glint path (the central 96 × 144 pixels of its 512 × 640 image:
-the same pixels, 0.82 mrad); frames 0.1 s apart. Top row: the glint as the expectation over each
-pixel's unresolved facets; bottom row: the same frames with glitter. One colour range for the figure.
+Writes ``glitter_clip.png`` to ``--out``: a 10 m mast looking 6° down, the sun 15° above the horizon
+straight ahead, wind 8 m/s, MWIR (3–5 µm), E_sun = 12 W m⁻², a 640-pixel-wide camera with a 30° field
+of view cropped to 96 × 144 pixels (0.82 mrad, 70–150 m range); frames 0.1 s apart. Rows 1–2: the
+crop looking at the sun (the path's core, a few glitter spots per pixel), smooth and with glitter, one
+colour range; rows 3–4: the crop turned 11° to the side (the path's edge, well under one spot per
+pixel: sparse flashes), smooth and with glitter, their own colour range. The glitter's draws are tied
+to the sea points the pixels see (``docs/glitter.md``).
 
 Usage:
     python examples/glitter_clip.py [--out docs] [--frames 3] [--dt 0.1]
@@ -22,6 +24,8 @@ import torch
 import roughsea_torch as rs
 from _common import save_grid
 
+EDGE_YAW_DEG = 11.0
+
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -32,21 +36,25 @@ def main() -> None:
     torch.set_num_threads(1)
     H, W = 96, 144  # the crop of a 512 × 640, 30° camera: same pixel size
     hfov = math.degrees(2 * math.atan(W / 640 * math.tan(math.radians(15.0))))
-    cam = rs.make_camera(H, W, hfov_deg=hfov, altitude_m=10.0, pitch_deg=-6.0, yaw_deg=0.0)
     scene = rs.SeaScene(wind_speed=8.0, sea_temperature=290.0, band=rs.MWIR, seed=4, sun=rs.Sun(math.radians(75.0), 0.0, 12.0),
                         foam=False)
     times = [i * args.dt for i in range(args.frames)]
-    rows = []
-    for glitter in (False, True):
-        clip = rs.render_clip(cam, scene, times, output="brightness_temperature", table=rs.TableSize(glitter=glitter))
-        rows.append(clip[0])  # (T, 1, H, W)
+    rows, titles, ranges = [], [], []
+    for yaw, where in ((0.0, "sun ahead"), (EDGE_YAW_DEG, f"{EDGE_YAW_DEG:g}° aside")):
+        cam = rs.make_camera(H, W, hfov_deg=hfov, altitude_m=10.0, pitch_deg=-6.0, yaw_deg=yaw)
+        pair = [rs.render_clip(cam, scene, times, output="brightness_temperature", table=rs.TableSize(glitter=g))[0]
+                for g in (False, True)]  # (T, 1, H, W) each
+        lo = float(torch.quantile(torch.cat(pair).flatten().float(), 0.005))
+        # in the core the smooth path's top (glitter spots clip to white); at the edge the flashes' own top
+        hi = float(torch.quantile((pair[0] if yaw == 0.0 else pair[1]).flatten().float(), 0.999))
+        for g, clip in zip((False, True), pair):
+            rows.append(clip)
+            titles += [f"{where}, {'glitter' if g else 'smooth (default)'}, t = {t:.2f} s" for t in times]
+            ranges += [(lo, hi)] * len(times)
     images = torch.cat(rows)
-    titles = [f"{'glitter' if g else 'smooth glint (default)'}, t = {t:.2f} s" for g in (False, True) for t in times]
-    lo = float(torch.quantile(images.flatten().float(), 0.005))
-    hi = float(torch.quantile(rows[0].flatten().float(), 0.999))  # the smooth path's top: glitter spots clip to white
     save_grid(images, titles, args.out / "glitter_clip.png", label="brightness temperature [K]", ncols=args.frames,
-              ranges=[(lo, hi)] * images.shape[0],
-              note="MWIR, sun 15° up ahead, 8 m/s, 10 m mast; one colour range (glitter spots clip at its top)")
+              ranges=ranges, note="MWIR, sun 15° up, 8 m/s, 10 m mast; rows 1–2 one colour range (spots clip at its top), "
+                                  "rows 3–4 another")
     print(f"wrote {args.out / 'glitter_clip.png'}")
 
 

@@ -43,6 +43,15 @@ def stats(img: torch.Tensor) -> tuple[float, float, float]:
     return m, float(v.std()) / m, float(torch.quantile(v, 0.99)) / m
 
 
+def neighbours(img: torch.Tensor) -> tuple[float, float]:
+    """The correlation across the patch between horizontally and between vertically adjacent pixels."""
+    v = img.double()
+
+    def corr(a: torch.Tensor, b: torch.Tensor) -> float:
+        return round(float(torch.corrcoef(torch.stack([a.flatten(), b.flatten()]))[0, 1]), 2)
+    return corr(v[:, 1:], v[:, :-1]), corr(v[1:], v[:-1])
+
+
 def scene(seed: int | None, sun: bool) -> rs.SeaScene:
     s = rs.Sun(SUN_ZENITH, 0.0, E_SUN if sun else 0.0)
     return rs.SeaScene(wind_speed=WIND, band=rs.MWIR, sea_temperature=290.0, seed=seed, sun=s, foam=False, path=False)
@@ -85,11 +94,20 @@ def run(seed: int, rays: int) -> dict[str, tuple[float, float, float]]:
     n_exp = G.glitter_count(p_sg, area, edet).reshape(H, W)
     n_pix = n_exp * (rnd / exp).clamp_min(0.0)
     spread = G.glitter_spread(cm, float(math.radians(0.2666) * det_j.sqrt().mean()))
-    draws = []
+    draws, lag, lag_ind = [], [], []
+    gx, gy = (c[i] + rng * d[:, i] for i in (0, 1))  # the pixels' flat-sea points, and their footprint across
     for g_seed in range(32):
-        zl = G.glitter_latent(g_seed, torch.arange(H * W), 0.0).reshape(H, W)
-        draws.append(stats(rnd * G.glitter_factor(n_pix, zl, spread)))
+        zl = G.glitter_latent(g_seed, gx, gy, rng * IFOV, 0.0).reshape(H, W)
+        img = rnd * G.glitter_factor(n_pix, zl, spread)
+        draws.append(stats(img))
+        lag.append(neighbours(img))
+        z_ind = G.glitter_latent(g_seed, 10.0 * torch.arange(H * W, dtype=torch.float64), 0.0, 1.0, 0.0).reshape(H, W)
+        lag_ind.append(neighbours(rnd * G.glitter_factor(n_pix, z_ind, spread)))
     out["render, first hit, glitter (32 draws)"] = tuple(sum(x[i] for x in draws) / len(draws) for i in range(3))
+    print(f"seed {seed}: correlation of neighbouring pixels (columns, rows), truth {neighbours(tr['glint'])}, "
+          f"first-hit render {neighbours(rnd)}, its glitter (32 draws) "
+          f"{tuple(round(sum(v[i] for v in lag) / len(lag), 2) for i in range(2))}, with independent pixels' latents "
+          f"{tuple(round(sum(v[i] for v in lag_ind) / len(lag_ind), 2) for i in range(2))}")
     # the expectation with the field's own total slope variance (what the brute force's surface has)
     fc = field.resolved_covariance(torch.zeros(1, dtype=torch.float64))
     sf = rs.SlopeStatistics.from_variances(float(fc[0]), float(fc[1]), float(fc[2]))

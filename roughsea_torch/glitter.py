@@ -68,16 +68,29 @@ and Var g = F(1 + κ)/N, the clustered compound Poisson's first two moments (a g
 log-normal's mean is exact in closed form for any σ, which the renderer's mean-preservation rests
 on, and a Gaussian z makes it coherent in time, below). For N ≫ F (1 + κ) it tends to 1.
 
-Coherence in time: z(t) = cos(πu/2) z_j + sin(πu/2) z_{j+1}, u = frac(t/τ + φ), j = ⌊t/τ + φ⌋, with
-i.i.d. N(0, 1) lattice values z_j per pixel (a counter-based hash of the seed, the pixel and j) and a
-phase φ per pixel: z(t) is exactly N(0, 1) at every t (cos² + sin² = 1), continuous, and independent
-beyond two lattice steps (correlation 0.91, 0.69, 0.32, 0.07 at 0.2, 0.4, 0.7, 1.0 τ); a pixel's
-excursions above z = 2 (the brightest 2 %) last 0.68 τ on average, above z = 1.5 0.82 τ. Which τ:
-the turnover of the specular points themselves is set by the curvature-weighted frequency ω_c of
+Coherence in time: each node of the lattice below carries z(t) = cos(πu/2) z_j + sin(πu/2) z_{j+1},
+u = frac(t/τ + φ), j = ⌊t/τ + φ⌋, with i.i.d. N(0, 1) values z_j (a counter-based hash of the seed,
+the node and j) and a phase φ per node: exactly N(0, 1) at every t (cos² + sin² = 1), continuous,
+correlated 0.95, 0.83, 0.57, 0.31 at 0.2, 0.4, 0.7, 1.0 τ and independent beyond 2τ; a point's
+excursions above z = 2 (the brightest 2 %) last 0.68 τ on average. Which τ: the turnover of the
+specular points themselves is set by the curvature-weighted frequency ω_c of
 :func:`curvature_moments`, 1/ω_c ≈ 21 ms for the default field's centimetre waves at 4–12 m/s, while
 MWIR sequences show hotspots lasting 0.15–0.20 s (Schwering 1991, Proc. SPIE 1486). The default
 τ = :data:`GLITTER_LIFETIME_S` = 0.25 s follows the measurement (hotspots of 0.17 s), not the
 derivation (``docs/glitter.md`` §1 discusses the gap, with the brute force's own turnover).
+
+Anchoring: the latent is a field on the sea, z(x, y, t) at the horizontal world point (x, y) a pixel
+sees, so that a camera that moves or turns finds the same glitter on the same sea points. The lattice
+follows the pixel's footprint s (its across-view size): with λ = log₂(s / 1 m), ℓ = ⌊λ⌋ and
+f = λ − ℓ, z = cos(πf/2) z_ℓ + sin(πf/2) z_{ℓ+1}, where z_ℓ is the field on the square lattice of
+cell 2^ℓ m, interpolated inside a cell from its four nodes with the weights cos or sin of π u/2 per
+axis (u the position in the cell). The eight weights' squares sum to 1, so z is exactly N(0, 1) at
+every point, footprint and time, and continuous in all three; points more than 2 cells (≤ 4 s) apart
+are independent, and points one footprint apart share nodes (their latents correlate by 0.26–0.39,
+as s falls between two powers of 2). The cells are fixed in the earth frame: the resolved waves, which move
+through them, carry the glint's bright facets (N follows the resolved slope), and the surface drift
+(~3 % of U10) moves a point by less than a footprint across the view within a lifetime beyond about
+70 m (``docs/glitter.md`` §1).
 """
 
 from __future__ import annotations
@@ -93,7 +106,7 @@ from .spectrum import check_wave_age, check_wind_speed, dispersion, elfouhaily_o
 
 __all__ = ["GLITTER_K_MAX", "GLITTER_LIFETIME_S", "GLITTER_CLUSTERING", "CurvatureMoments", "curvature_moments",
            "mean_abs_hessian_determinant", "specular_slope_density", "glitter_count", "glitter_spread",
-           "glitter_factor", "glitter_factor_unchecked", "glitter_latent"]
+           "glitter_factor", "glitter_factor_unchecked", "glitter_latent", "glitter_latent_unchecked"]
 
 GLITTER_K_MAX = 256.0  # [rad m⁻¹] the curvature's top wavenumber: the default wave field's shortest band edge
 GLITTER_LIFETIME_S = 0.25  # [s] the latent's step τ: hotspots (z > 2) then last 0.17 s, Schwering's (1991) 0.15–0.20 s
@@ -102,7 +115,7 @@ _DECADES = 14.0  # e-folds of wavenumber below k_max in the moments' integral (k
 _N_K = 192  # Gauss–Legendre nodes in ln k
 _N_PSI = 64  # uniform nodes of the periodic ψ average of E|det H|
 _N_HESS = 4096  # quasi-random Hessians of glitter_spread
-_MASK64 = (1 << 64) - 1
+_STEP = -7046029254386353131  # odd 64-bit multipliers of the lattice hash (int64)
 
 
 class CurvatureMoments(NamedTuple):
@@ -251,38 +264,73 @@ def _hash(x: torch.Tensor) -> torch.Tensor:
     return x ^ shr(x, 31)
 
 
+def _bits_uniform(h: torch.Tensor) -> torch.Tensor:
+    """A float64 in (0, 1) from the top 52 bits of ``h`` (already a hash)."""
+    return (((h >> 12) & ((1 << 52) - 1)).to(torch.float64) + 0.5) * (2.0 ** -52)
+
+
 def _uniform(key: torch.Tensor) -> torch.Tensor:
-    """A float64 in (0, 1) from the top 52 bits of the hash of ``key``."""
-    return (((_hash(key) >> 12) & ((1 << 52) - 1)).to(torch.float64) + 0.5) * (2.0 ** -52)
+    """A float64 in (0, 1) from the hash of ``key``."""
+    return _bits_uniform(_hash(key))
 
 
-def _normal(key: torch.Tensor) -> torch.Tensor:
-    """A standard normal (Box–Muller) from two hashed uniforms of ``key``."""
-    u1, u2 = _uniform(key * 2), _uniform(key * 2 + 1)
-    return torch.sqrt(-2.0 * torch.log(u1)) * torch.cos(2.0 * math.pi * u2)
+def _in_time(key: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
+    """z(t) of lattice nodes ``key`` (int64 hashes) at ``t`` in lifetimes: cos(πu/2) z_j + sin(πu/2) z_{j+1}
+    with u = frac(t + φ), j = ⌊t + φ⌋, a phase φ (the key's own bits) and i.i.d. N(0, 1) values z_j per
+    node (the inverse normal CDF of the hash of the key and j)."""
+    s = t + _bits_uniform(key)
+    j = torch.floor(s)
+    u = s - j
+    kj = key + j.to(torch.int64) * _STEP  # (an odd multiplier: distinct steps, distinct keys)
+    z0 = torch.special.ndtri(_uniform(kj))
+    z1 = torch.special.ndtri(_uniform(kj + _STEP))
+    return torch.cos(0.5 * math.pi * u) * z0 + torch.sin(0.5 * math.pi * u) * z1
 
 
-def glitter_latent(seed: Any, index: torch.Tensor, time_s: Any = 0.0, lifetime_s: Any = GLITTER_LIFETIME_S) -> torch.Tensor:
-    """The latent z(t) ~ N(0, 1) of pixels ``index`` (int64 tensor, e.g. flat pixel numbers) of one
-    image with seed ``seed`` (int in [0, 2**63)) at time ``time_s`` [s] (float or tensor broadcasting
-    with ``index``, |t| ≤ 1e9) for a lifetime ``lifetime_s`` [s] > 0 (module docstring): float64,
-    index's shape; the same arguments give the same values on every device."""
+def glitter_latent(seed: Any, x: Any, y: Any, footprint: Any, time_s: Any = 0.0,
+                   lifetime_s: Any = GLITTER_LIFETIME_S) -> torch.Tensor:
+    """The latent z(t) ~ N(0, 1) of sea points (``x``, ``y``) [m] (horizontal world coordinates, each
+    in [−1e7, 1e7]) seen by pixels whose footprint measures ``footprint`` [m] (their across-view size,
+    in [1e-6, 1e6]) in a realization with seed ``seed`` (int in [0, 2**63)) at time ``time_s`` [s]
+    (|t| ≤ 1e9) for a lifetime ``lifetime_s`` [s] > 0 (module docstring, *Anchoring*). Arguments
+    broadcast; float64 of the broadcast shape, on the inputs' device; the same arguments give the
+    same values on every device. Not differentiable (a draw)."""
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 63:
         raise ValueError(f"seed must be an int in [0, 2**63); got {seed!r}")
+    check_finite_range("x", x, -1e7, 1e7, unit="m")
+    check_finite_range("y", y, -1e7, 1e7, unit="m")
+    check_finite_range("footprint", footprint, 1e-6, 1e6, unit="m")
     check_finite_range("time_s", time_s, -1e9, 1e9, unit="s")
     check_finite_range("lifetime_s", lifetime_s, 0.0, 1e6, lo_open=True, unit="s")
-    if not isinstance(index, torch.Tensor) or index.dtype != torch.int64 or (index.numel() and bool((index < 0).any())):
-        raise ValueError("index must be an int64 tensor of non-negative pixel numbers")
-    dev = index.device
-    base = _hash(torch.full_like(index, seed)) ^ (index * 1_000_003)
-    phase = _uniform(base * 3 + 7)
-    t = as_tensor(time_s, torch.float64, dev) / as_tensor(lifetime_s, torch.float64, dev) + phase
-    j = torch.floor(t)
-    u = t - j
-    jl = j.to(torch.int64)
-    z0 = _normal(_hash(base + jl * 7919))
-    z1 = _normal(_hash(base + (jl + 1) * 7919))
-    return torch.cos(0.5 * math.pi * u) * z0 + torch.sin(0.5 * math.pi * u) * z1
+    _, device = resolve_dtype_device(x=x, y=y, footprint=footprint, time_s=time_s, lifetime_s=lifetime_s)
+    f64 = lambda v: as_tensor(v, torch.float64, device).detach()  # noqa: E731
+    return glitter_latent_unchecked(seed, f64(x), f64(y), f64(footprint), f64(time_s) / f64(lifetime_s))
+
+
+def glitter_latent_unchecked(seed: int, x: torch.Tensor, y: torch.Tensor, footprint: torch.Tensor,
+                             t: torch.Tensor) -> torch.Tensor:
+    """:func:`glitter_latent` without its checks, ``t`` in lifetimes: float64 tensors on one device
+    that broadcast (the renderer's own pixels)."""
+    x, y, footprint, t = torch.broadcast_tensors(x, y, footprint, t)
+    lev = torch.log2(footprint)
+    l0 = torch.floor(lev)
+    f = lev - l0
+    level = torch.stack([l0, l0 + 1.0])  # (2, …): the two levels about the footprint
+    w_level = torch.stack([torch.cos(0.5 * math.pi * f), torch.sin(0.5 * math.pi * f)])
+    cell = torch.exp2(level)
+    gx, gy = x / cell, y / cell
+    ix, iy = torch.floor(gx), torch.floor(gy)
+    ux, uy = gx - ix, gy - iy
+    base = int(_hash(torch.tensor([seed]))[0]) + level.to(torch.int64) * -4658895280553007687
+    ix, iy = ix.to(torch.int64), iy.to(torch.int64)
+    z = torch.zeros_like(x)
+    for a in (0, 1):
+        wx = torch.cos(0.5 * math.pi * ux) if a == 0 else torch.sin(0.5 * math.pi * ux)
+        for b in (0, 1):
+            wy = torch.cos(0.5 * math.pi * uy) if b == 0 else torch.sin(0.5 * math.pi * uy)
+            key = _hash(base + (ix + a) * -7723592293110705685 + (iy + b) * 0x5851F42D4C957F2D)
+            z = z + (w_level * wx * wy * _in_time(key, t)).sum(0)
+    return z
 
 
 def glitter_factor(count: Any, latent: Any, spread: Any = 1.0) -> torch.Tensor:

@@ -3,6 +3,7 @@ weight spread, and the time-coherent glitter factor of mean 1."""
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -69,32 +70,70 @@ def test_glitter_factor_has_mean_one_and_variance_spread_over_n(count, spread):
     if count >= 0.5:
         assert abs((w * g).sum() - 1.0) < 1e-10
         assert abs((w * g * g).sum() - (1.0 + spread / count)) < 1e-8 * (1.0 + spread / count)
-    # by sampling the latent the renderer uses, over seeds and pixels (4M draws): the mean within 1e-3
+    # by sampling the latent the renderer uses, over seeds and scattered sea points (4M draws): the mean within 1e-3
     if count >= 6.0:
-        z = torch.cat([G.glitter_latent(s, torch.arange(1_000_000), 0.3 * s) for s in range(4)])
+        z = _four_million_latents()
         g = G.glitter_factor(torch.tensor(count, dtype=torch.float64), z, spread)
         assert abs(float(g.mean()) - 1.0) < 1e-3
         assert abs(float(g.var()) / (spread / count) - 1.0) < 0.02
 
 
+@functools.lru_cache(maxsize=1)
+def _four_million_latents():
+    return torch.cat([_scattered_latent(s, 1_000_000, 0.3 * s) for s in range(4)])
+
+
+def _scattered_latent(seed, n, t, lifetime=G.GLITTER_LIFETIME_S):
+    """The latent at n sea points scattered over a 20 km square with footprints of 1 cm to 1 m (log-
+    uniform; nearly all pairs many footprints apart), at time t."""
+    gen = torch.Generator().manual_seed(1000 + seed)
+    x, y = (torch.rand(2, n, generator=gen, dtype=torch.float64) - 0.5) * 2e4
+    fp = torch.exp(math.log(0.01) + math.log(100.0) * torch.rand(n, generator=gen, dtype=torch.float64))
+    return G.glitter_latent(seed, x, y, fp, t, lifetime)
+
+
 def test_glitter_latent_is_standard_normal_reproducible_and_coherent_in_time():
-    idx = torch.arange(1_000_000)
-    z = G.glitter_latent(11, idx, 4.2, 0.175)
+    z = _scattered_latent(11, 1_000_000, 4.2, 0.175)
     assert abs(float(z.mean())) < 5e-3 and abs(float(z.std()) - 1.0) < 5e-3
-    assert abs(float((z > 2.0).double().mean()) - 0.02275) < 1e-3  # the normal's tail
-    assert abs(float((z[1:] * z[:-1]).mean())) < 5e-3  # neighbouring pixels independent
-    assert torch.equal(z, G.glitter_latent(11, idx, 4.2, 0.175))
-    extreme = G.glitter_latent(2 ** 63 - 1, idx, 1e9)  # the largest seed and time a scene accepts
+    for c, tail in ((2.0, 0.02275), (3.0, 0.00135)):  # the normal's tails
+        assert abs(float((z > c).double().mean()) - tail) < 4 * math.sqrt(tail / 1e6)
+    assert torch.equal(z, _scattered_latent(11, 1_000_000, 4.2, 0.175))
+    gen = torch.Generator().manual_seed(5)
+    x, y = (torch.rand(2, 1_000_000, generator=gen, dtype=torch.float64) - 0.5) * 2e4
+    extreme = G.glitter_latent(2 ** 63 - 1, x * 500, y * 500, 1e-6, 1e9)  # the largest seed, coordinates and time
     assert abs(float(extreme.mean())) < 5e-3 and abs(float(extreme.std()) - 1.0) < 5e-3
-    assert not torch.equal(z, G.glitter_latent(12, idx, 4.2, 0.175))
-    near = G.glitter_latent(11, idx, 4.2 + 0.005, 0.175)
-    far = G.glitter_latent(11, idx, 4.2 + 0.5, 0.175)  # beyond two lattice steps
+    assert abs(float((z * _scattered_latent(12, 1_000_000, 4.2, 0.175)).mean())) < 5e-3  # another seed: independent
+    near = _scattered_latent(11, 1_000_000, 4.2 + 0.005, 0.175)
+    far = _scattered_latent(11, 1_000_000, 4.2 + 0.5, 0.175)  # beyond two lattice steps
     assert float((z * near).mean()) > 0.99
     assert abs(float((z * far).mean())) < 5e-3
-    # a pixel's factor changes continuously: no jump at the lattice's steps
+    # a point's latent changes continuously: no jump at the lattice's steps in time
     t = torch.linspace(0.0, 1.0, 2001, dtype=torch.float64)
-    path = torch.stack([G.glitter_latent(3, torch.tensor([5]), float(ti)) for ti in t]).squeeze(1)
+    path = G.glitter_latent(3, 12.3, -4.5, 0.07, t)
     assert float((path[1:] - path[:-1]).abs().max()) < 0.05
+
+
+def test_glitter_latent_is_a_field_on_the_sea_at_the_footprint_scale():
+    """z(x, y) at one footprint s: continuous in x, y and s (no jump at the cells' edges nor between
+    the two levels blended about log₂ s); correlated between points a small fraction of s apart and
+    independent beyond 4 s (the cells are between s/2 and 2s); N(0, 1) for any s, at a level boundary
+    (s a power of 2) and between them."""
+    s = 0.3
+    xs = torch.linspace(-2.0, 2.0, 4001, dtype=torch.float64)  # 1 mm steps over 13 footprints
+    line = G.glitter_latent(7, 100.0 + xs, 55.0 + 0.4 * xs, s)
+    assert float((line[1:] - line[:-1]).abs().max()) < 0.05
+    fps = torch.exp(torch.linspace(math.log(0.05), math.log(5.0), 4001, dtype=torch.float64))
+    scale = G.glitter_latent(7, 100.0, 55.0, fps)
+    assert float((scale[1:] - scale[:-1]).abs().max()) < 0.05
+    gen = torch.Generator().manual_seed(2)
+    x, y = (torch.rand(2, 500_000, generator=gen, dtype=torch.float64) - 0.5) * 2e4
+    for fp in (0.25, 0.37, 1.0, 1.7):
+        z = G.glitter_latent(9, x, y, fp, 1.3)
+        assert abs(float(z.mean())) < 7e-3 and abs(float(z.std()) - 1.0) < 7e-3
+        close = G.glitter_latent(9, x + 0.02 * fp, y - 0.02 * fp, fp, 1.3)
+        apart = G.glitter_latent(9, x + 4.01 * fp, y, fp, 1.3)
+        assert float((z * close).mean()) > 0.95
+        assert abs(float((z * apart).mean())) < 7e-3
 
 
 @pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
@@ -133,9 +172,11 @@ def test_glitter_spread_grows_as_the_cap_loosens():
     (lambda: G.glitter_factor(-1.0, 0.0), "count"),
     (lambda: G.glitter_factor(1.0, float("nan")), "latent"),
     (lambda: G.glitter_factor(1.0, 0.0, 0.5), "spread"),
-    (lambda: G.glitter_latent(-1, torch.arange(3)), "seed"),
-    (lambda: G.glitter_latent(1, torch.arange(3), 0.0, 0.0), "lifetime_s"),
-    (lambda: G.glitter_latent(1, torch.arange(3.0)), "index"),
+    (lambda: G.glitter_latent(-1, 0.0, 0.0, 1.0), "seed"),
+    (lambda: G.glitter_latent(1, 0.0, 0.0, 1.0, 0.0, 0.0), "lifetime_s"),
+    (lambda: G.glitter_latent(1, float("nan"), 0.0, 1.0), "x"),
+    (lambda: G.glitter_latent(1, 0.0, 2e7, 1.0), "y"),
+    (lambda: G.glitter_latent(1, 0.0, 0.0, 0.0), "footprint"),
     (lambda: G.curvature_moments(0.0), "wind_speed"),
     (lambda: G.curvature_moments(8.0, k_max=0.5), "k_max"),
     (lambda: G.mean_abs_hessian_determinant(1.0, 1.0, 2.0), "positive definite"),
@@ -148,11 +189,15 @@ def test_bad_input_raises_value_error_naming_the_argument(call, match):
 
 
 def test_default_hotspots_last_as_long_as_measured():
-    """At the default step, a pixel's hotspots (latent above 2: its brightest 2 %) last 0.15–0.20 s
-    on average, Schwering's (1991) measured MWIR hotspot lifetimes."""
+    """At the default step, the hotspots of a sea point (latent above 2: its brightest 2 %) last
+    0.15–0.20 s on average, Schwering's (1991) measured MWIR hotspot lifetimes; for points at level
+    boundaries (one level, four nodes) and between them (two levels, eight nodes with their own phases)."""
     dt = 0.005
     t = torch.arange(0.0, 12.0, dt, dtype=torch.float64)
-    z = G.glitter_latent(1, torch.arange(1000)[None, :], t[:, None], G.GLITTER_LIFETIME_S)  # (T, P)
+    gen = torch.Generator().manual_seed(3)
+    x, y = (torch.rand(2, 1000, generator=gen, dtype=torch.float64) - 0.5) * 1e3
+    fp = torch.tensor([0.5, 0.7] * 500, dtype=torch.float64)
+    z = G.glitter_latent(1, x[None, :], y[None, :], fp[None, :], t[:, None], G.GLITTER_LIFETIME_S)  # (T, P)
     a = np.vstack([np.zeros((1, 1000)), (z > 2.0).numpy().astype(int), np.zeros((1, 1000))])
     edges = np.diff(a, axis=0)
     runs = (np.flatnonzero(edges.T.reshape(-1) == -1) - np.flatnonzero(edges.T.reshape(-1) == 1)) * dt

@@ -16,14 +16,15 @@ Radiance in W m⁻² sr⁻¹ in the scene's band; azimuths relative to upwind.
 
 from __future__ import annotations
 
+import contextlib
 import math
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import torch
 
 from ..clutter import along_view, two_scale_statistics
 from ..geometry import slant_range
-from ..glitter import (curvature_moments, glitter_factor_unchecked, glitter_latent, glitter_spread,
+from ..glitter import (curvature_moments, glitter_factor_unchecked, glitter_latent_unchecked, glitter_spread,
                        mean_abs_hessian_determinant, specular_slope_density)
 from ..slopes import SlopeStatistics
 from ..sun import glint_from_moments, glint_sharp_factor, sun_masking_factor
@@ -33,8 +34,29 @@ from .sky_terms import relative_sun
 from .spectral import barycentric, lobatto_interp
 from .texture import single_quantile
 
-__all__ = ["glint_mask", "glint_pixels", "glint_table", "glint_sharp_pixels", "glitter_inputs", "over_kept_pixels",
-           "upwind_los"]
+__all__ = ["glint_mask", "glint_pixels", "glint_table", "glint_sharp_pixels", "glitter_inputs", "fixed_glitter_latent",
+           "over_kept_pixels", "upwind_los"]
+
+_FIXED_LATENT: list[float | None] = [None]  # fixed_glitter_latent's value while its block runs
+
+
+@contextlib.contextmanager
+def fixed_glitter_latent(z: float) -> Iterator[None]:
+    """Within the ``with`` block, every textured pixel's glitter latent is ``z`` (a finite float in
+    [−40, 40]) instead of its draw (:func:`~roughsea_torch.glitter.glitter_latent`). For evaluating a
+    render's mean over the latent exactly: Σᵢ wᵢ render(zᵢ) over Gauss–Hermite nodes zᵢ and weights wᵢ
+    (probabilists') is the ensemble mean of the glitter, node by node for every pixel at once
+    (``tests/renderer/test_glint.py``). Process-wide (renders in other threads see it too); not
+    reentrant."""
+    if isinstance(z, bool) or not isinstance(z, (int, float)) or not -40.0 <= float(z) <= 40.0:
+        raise ValueError(f"z must be a finite number in [-40, 40]; got {z!r}")
+    if _FIXED_LATENT[0] is not None:
+        raise ValueError("fixed_glitter_latent is already active (not reentrant)")
+    _FIXED_LATENT[0] = float(z)
+    try:
+        yield
+    finally:
+        _FIXED_LATENT[0] = None
 
 
 def over_kept_pixels(keep: torch.Tensor, fn: Any, dtype: torch.dtype) -> torch.Tensor:
@@ -103,8 +125,10 @@ def glint_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: torch.Te
     (``resolved[0]`` may be the pair (x, x'), x' the visible quantile read from the texture volume).
     ``tau_rows`` = (τ at the fine table's sea rows (b, M_z), each pixel's fractional row (b, H, W))
     with a path, else None. ``glitter`` (textured seas only): :func:`glitter_inputs`' (footprint area,
-    E|det H|, F (1 + κ), and the latent's pixel numbers, seeds, times and step); each pixel's glint is then multiplied by its glitter factor, N = area ·
-    p(s_g) · E|det H| with p the pixel's own unresolved Gaussian (:mod:`roughsea_torch.glitter`)."""
+    E|det H|, F (1 + κ), and the latent's sea points and footprints, seeds, times and step); each pixel's
+    glint is then multiplied by its glitter factor, N = area · p(s_g) · E|det H| with p the pixel's own
+    unresolved Gaussian, z the latent at its flat-sea point (:mod:`roughsea_torch.glitter`), or the value
+    :func:`fixed_glitter_latent` sets."""
     b_, H, W = cos_t.shape
     dtype, device = cos_t.dtype, cos_t.device
     B = p.vx.shape[0]
@@ -134,10 +158,14 @@ def glint_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: torch.Te
             (vx, vy, cxy), (mx, my) = shifted.tensors(dtype, device), shifted.mean_tensors(dtype, device)
         g = glint_from_moments(torch.acos(c_k.clamp(-1.0, 1.0)), phi, vx, vy, cxy, mx, my, n_, k_, tz, tp, e_sun, al, scene.shadowing)
         if glitter is not None and mx is not None:
-            area, edet, spread, pixel, seeds, times, tau = glitter
+            area, edet, spread, (gx, gy, across), seeds, times, tau = glitter
             p_sg, _ = specular_slope_density(c_k, torch.sqrt((1.0 - c_k * c_k).clamp_min(0.0)), torch.cos(phi), torch.sin(phi),
                                              vx, vy, cxy, mx, my, tz, tp)
-            z = glitter_latent(seeds[m], at(pixel), float(times[m]), tau).to(dtype)  # at the kept pixels only
+            if _FIXED_LATENT[0] is None:  # at the kept pixels only
+                z = glitter_latent_unchecked(seeds[m], at(gx), at(gy), at(across),
+                                             torch.tensor(float(times[m]) / tau, dtype=torch.float64, device=device)).to(dtype)
+            else:
+                z = torch.full_like(p_sg, _FIXED_LATENT[0])
             g = g * glitter_factor_unchecked(at(area) * p_sg * edet[m], z, spread[m])
         if g1 is not None:
             g = g * g1[m]
@@ -154,28 +182,33 @@ def glint_pixels(scene: SeaScene, p: SceneParameters, sl: slice, cos_t: torch.Te
     return over_kept_pixels(keep, glint_of_pixels, dtype)
 
 
-def glitter_inputs(field: Any, cos_t: torch.Tensor, altitude: torch.Tensor, ifov: torch.Tensor, earth_radius_m: float,
-                   time_s: torch.Tensor, sun_zenith: torch.Tensor, sun_radius: torch.Tensor, lifetime_s: float
-                   ) -> tuple[torch.Tensor, ...]:
+def glitter_inputs(field: Any, cos_t: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, centres: torch.Tensor,
+                   altitude: torch.Tensor, ifov: torch.Tensor, earth_radius_m: float, time_s: torch.Tensor,
+                   sun_zenith: torch.Tensor, sun_radius: torch.Tensor, lifetime_s: float) -> tuple[Any, ...]:
     """The glitter's inputs for :func:`glint_pixels` of a chunk of b images (:mod:`roughsea_torch.glitter`):
     each pixel's horizontal footprint area (R δ)² / cos θ̂ [m²] (b, H, W) (R the slant range at the
     camera ``altitude`` (b,), δ = ``ifov`` (b,), cos θ̂ = ``cos_t``); E|det H| (b,) and F (1 + κ) (b,) from
     the curvature of the image's wave ``field`` (its wind and wave age, up to its top band edge), κ
     at the sun ellipse's radius α/(2 √cos θ_sun) of the sun's own mirror direction; and what the
     latent z of a pixel needs (:func:`~roughsea_torch.glitter.glitter_latent`, evaluated at the
-    pixels that can see glint): the pixels' flat numbers (b, H, W) int64, the field's seeds (so a
-    clip's frames of one realization share their glitter's history), the images' times ``time_s``
-    (b,) and ``lifetime_s``."""
-    b_, H, W = cos_t.shape
-    dtype, device = cos_t.dtype, cos_t.device
+    pixels that can see glint): the world x, y [m] of the pixel's flat-sea point (the camera's
+    ``centres`` (b, 3) plus R times the ray's world components ``dx``, ``dy``) and its across-view
+    footprint R δ [m], float64 (b, H, W) without gradient; the field's seeds (so a clip's frames of
+    one realization share their glitter's history), the images' times ``time_s`` (b,) and
+    ``lifetime_s``."""
+    dtype = cos_t.dtype
     R = slant_range(cos_t, altitude.to(dtype)[:, None, None], earth_radius_m)
     area = (R * ifov.to(dtype)[:, None, None]) ** 2 / cos_t.clamp_min(1e-9)
     mom = curvature_moments(field.wind_speed.detach(), field.inverse_wave_age.detach(), float(field.bands.k_edges[-1]))
     edet = mean_abs_hessian_determinant(mom.uu, mom.cc, mom.uc).to(dtype)
     radius = sun_radius.detach().to(torch.float64) * 0.5 * torch.rsqrt(torch.cos(sun_zenith.detach().to(torch.float64)).clamp_min(1e-3))
     spread = glitter_spread(mom, radius.clamp(1e-9, 1.0)).to(dtype)
-    pixel = torch.arange(H * W, device=device).reshape(1, H, W).expand(b_, H, W)
-    return area, edet, spread, pixel, tuple(int(v) for v in field.seeds), time_s.detach().cpu(), lifetime_s
+    with torch.no_grad():
+        r64, c64 = R.to(torch.float64), centres.to(torch.float64)
+        x = c64[:, 0, None, None] + r64 * dx.to(torch.float64)
+        y = c64[:, 1, None, None] + r64 * dy.to(torch.float64)
+        across = (r64 * ifov.to(torch.float64)[:, None, None]).clamp_min(1e-6)
+    return area, edet, spread, (x, y, across), tuple(int(v) for v in field.seeds), time_s.detach().cpu(), lifetime_s
 
 
 def glint_table(scene: SeaScene, p: SceneParameters, sl: slice, eps: torch.Tensor, lo: torch.Tensor,

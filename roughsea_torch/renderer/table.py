@@ -563,8 +563,8 @@ def pixel_glint(plan: RenderPlan, ft: FineTable, rays: PixelRays, cos_t: torch.T
         sun = plan.scene.sun
         zen = torch.as_tensor(sun.zenith, dtype=torch.float64).expand(plan.B)[sl]
         rad = torch.as_tensor(sun.radius, dtype=torch.float64).expand(plan.B)[sl]
-        glitter = glitter_inputs(tex.field(sl), cos_t, tex.altitude[sl], tex.ifov[sl], tex.earth_radius_m, tex.time[sl],
-                                 zen, rad, plan.table.glitter_lifetime_s)
+        glitter = glitter_inputs(tex.field(sl), cos_t, rays.dx, rays.dy, tex.centres[sl], tex.altitude[sl], tex.ifov[sl],
+                                 tex.earth_radius_m, tex.time[sl], zen, rad, plan.table.glitter_lifetime_s)
     glint = glint_pixels(plan.scene, p, sl, cos_t, rays.dx, rays.dy, sea, rows, resolved, glitter)
     if p.foam is not None and not ft.crest:
         glint = glint * (1.0 - p.foam[sl].to(dtype))[:, None, None]

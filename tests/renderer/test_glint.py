@@ -6,10 +6,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 import torch
 
 import roughsea_torch as rs
+from roughsea_torch.renderer.glint import fixed_glitter_latent
 
 from conftest import make_cams, make_scene
 
@@ -95,23 +97,102 @@ def _glitter_pair(times, table_kw=None, dtype=torch.float64, seed=4):
     return out
 
 
+def _block_ratio(plain, glit, keep, rows=2, cols=4):
+    """The glint-weighted mean ratio Σ w r over the kept pixels and its standard error from blocks of
+    rows × cols pixels (the glitter is correlated over about one footprint across the view, so
+    neighbouring columns are not independent): (mean, standard error)."""
+    w = torch.where(keep, plain, torch.zeros_like(plain))
+    wr = torch.where(keep, glit, torch.zeros_like(glit))
+    pool = lambda t: torch.nn.functional.avg_pool2d(t.reshape(-1, 1, *t.shape[-2:]), (rows, cols)).flatten()  # noqa: E731
+    bw, bwr = pool(w), pool(wr)
+    ok = bw > 0
+    bw, bwr = bw[ok], bwr[ok]
+    mean = float(bwr.sum() / bw.sum())
+    n = bw.numel()
+    se = float(torch.sqrt(((bwr - mean * bw) ** 2).sum() * n / (n - 1)) / bw.sum())
+    return mean, se
+
+
 def test_glitter_keeps_the_glint_mean_and_sparkles():
-    """TableSize(glitter=True) multiplies each textured pixel's glint by a factor of mean 1: over the
-    pixels of independent frames (1 s apart, beyond two of the default 0.25 s steps) the glint-weighted mean
-    ratio is 1 within four standard errors (measured ~1e-2 here: the exact mean is tested on the
-    factor itself, tests/test_glitter.py), while the spread across pixels grows and the 99th
-    percentile rises well above the smooth path's (near range: a few spots per pixel)."""
+    """TableSize(glitter=True) multiplies each textured pixel's glint by a factor of mean 1: the mean
+    over a clip's frames (1 s apart, beyond two of the default 0.25 s steps) and pixels, weighted by
+    the glint, is the render without glitter within three standard errors (from 2 × 4 pixel blocks;
+    measured ~1e-2 here: the exact mean is the Gauss–Hermite test below), while the spread across
+    pixels grows and the 99th percentile rises well above the smooth path's (near range: a few spots
+    per pixel)."""
     plain, glit = _glitter_pair([0.0, 1.0, 2.0, 3.0])
     keep = plain > 0.05 * plain.max()
-    r = (glit / plain)[keep]
-    w = plain[keep] / plain[keep].sum()
-    mean = float((w * r).sum())
-    se = float(torch.sqrt((w * w * (r - mean) ** 2).sum()))
-    assert abs(mean - 1.0) < 4 * se and se < 0.02
+    mean, se = _block_ratio(plain, glit, keep)
+    assert abs(mean - 1.0) < 3 * se and se < 0.03, (mean, se)
     cv = lambda t: float(t.std() / t.mean())  # noqa: E731
     q99 = lambda t: float(torch.quantile(t, 0.99) / t.mean())  # noqa: E731
     assert cv(glit[keep]) > 1.5 * cv(plain[keep])
     assert q99(glit[keep]) > 2.0 * q99(plain[keep])
+
+
+def test_glitter_render_mean_over_the_latent_is_the_render_without_glitter(dtype):
+    """The ensemble mean of the glitter at render level, without sampling error: the latent forced to
+    each node zᵢ of a 32-node Gauss–Hermite rule for every pixel (``fixed_glitter_latent``), the renders
+    summed with the weights, equal the render without glitter within 1e-3 of each pixel's glint
+    (E g = 1 for g = exp(σz − σ²/2); the rule is exact to 1e-15 for σ ≤ 4, the largest σ a pixel
+    reaches being ln(1 + F(1 + κ)·1e6)^½ ≈ 4). Textured MWIR near range with the path (its τ multiplies
+    the glint too), float64 and float32 (the issue asks 1e-3; measured 1.2e-15 and 2.3e-7). Planted:
+    the −σ²/2 dropped (2.3 off); σ² in the exponent's −σ²/2 taken 2 % larger than in σz (2.4e-2 off)."""
+    cams = make_cams(24, 32, hfov_deg=32 * 0.047, altitude_m=10.0, pitch_deg=-8.0, dtype=dtype)
+    kw = dict(band=rs.MWIR, seed=4, foam=False)
+    lit = make_scene(sun=rs.Sun(math.radians(75.0), 0.0, 12.0), **kw)
+    plain = rs.render(cams, lit)
+    glint = (plain - rs.render(cams, make_scene(sun=rs.Sun(math.radians(75.0), 0.0, 0.0), **kw))).double()
+    x, w = np.polynomial.hermite_e.hermegauss(32)
+    w = w / w.sum()
+    on = rs.TableSize(glitter=True)
+    mean = torch.zeros_like(glint)
+    renders = {}
+    for xi, wi in zip(x, w):
+        with fixed_glitter_latent(float(xi)):
+            r = rs.render(cams, lit, table=on).double()
+        renders[float(xi)] = r
+        mean = mean + wi * r
+    keep = glint > 1e-3 * glint.max()
+    assert int(keep.sum()) > 200
+    err = float(((mean - plain.double()).abs() / glint)[keep].max())
+    assert err < (1e-5 if dtype == torch.float32 else 1e-9), err
+    # the nodes are far apart: the glint at a high node is many times the plain glint at some pixels
+    hi = renders[float(x[-6])]  # z ≈ 3.6
+    assert float(((hi - plain.double()) / glint)[keep].max()) > 2.0
+
+
+def test_glitter_is_tied_to_the_sea_not_to_the_pixel_grid():
+    """A camera yawed by one pixel at the same instant sees the same glitter on the same sea points:
+    the log glitter factor (glint with glitter over without) of its column j correlates ≥ 0.9 with the
+    unturned camera's column j ± 1 (the one whose sea points coincide, to 5 % of a footprint), and
+    about 0 for a realization of another seed (measured 0.9997 and 0.03; the same column of both
+    cameras, 0.38: neighbouring columns share lattice cells). Planted: a latent tied to the pixel
+    numbers (the old one) gives 0.04."""
+    def factor(yaw, seed):
+        cams = make_cams(40, 48, hfov_deg=48 * 0.047, altitude_m=10.0, pitch_deg=-8.0, yaw_deg=yaw)
+        kw = dict(band=rs.MWIR, seed=seed, foam=False, path=False)
+        on = rs.TableSize(glitter=True)
+        dark = rs.render(cams, make_scene(sun=rs.Sun(math.radians(75.0), 0.0, 0.0), **kw))
+        lit = make_scene(sun=rs.Sun(math.radians(75.0), 0.0, 12.0), **kw)
+        glint = (rs.render(cams, lit) - dark)[0, 0]
+        geo = rs.view_geometry(cams)
+        pts = torch.stack([geo.range_m * geo.dx, geo.range_m * geo.dy])[:, 0]
+        return torch.log((rs.render(cams, lit, table=on) - dark)[0, 0] / glint), glint, pts, geo.range_m[0]
+
+    f0, g0, p0, r0 = factor(0.0, 4)
+    step = math.degrees(math.atan(math.tan(math.radians(48 * 0.047 / 2)) / 24))  # one pixel at the centre
+    f1, _, p1, _ = factor(step, 4)
+    f2, _, _, _ = factor(step, 5)
+    shift = 1 if float((p1[:, :, :-1] - p0[:, :, 1:]).abs().max()) < float((p1[:, :, 1:] - p0[:, :, :-1]).abs().max()) else -1
+    a = (slice(None), slice(None, -1)) if shift == 1 else (slice(None), slice(1, None))
+    b = (slice(None), slice(1, None)) if shift == 1 else (slice(None), slice(None, -1))
+    mismatch = (p1[(slice(None),) + a] - p0[(slice(None),) + b]).norm(dim=0) / (r0[b] * 0.047 * math.pi / 180)
+    assert float(mismatch.max()) < 0.05
+    keep = g0[b] > 0.05 * g0.max()
+    corr = lambda u, v: float(torch.corrcoef(torch.stack([u[keep], v[keep]]))[0, 1])  # noqa: E731
+    assert corr(f1[a], f0[b]) >= 0.9
+    assert abs(corr(f2[a], f0[b])) < 0.15
 
 
 def test_glitter_is_coherent_in_time():
