@@ -344,8 +344,8 @@ class TextureTable:
         X, Y, t_s = sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1]
         eta = wf.sample_unchecked(X, Y, t_s, fp, elevation=True, crest=False, slopes=False)["elevation"]
         t, m = sweep_envelope(sw, eta[0].reshape(ns, nt))
-        sel = visible_samples(m).T.reshape(-1).nonzero().squeeze(1)  # visible samples, sample-major (ns, nt)
-        row, col = sel // nt, sel % nt
+        row, col = visible_samples(m).T.nonzero().unbind(1)  # the visible samples, sample-major (ns, nt)
+        sel = row * nt + col
         smp = wf.sample_unchecked(X[:, sel], Y[:, sel], t_s, fp[:, sel], elevation=False, crest=crest)
         cov = wf.resolved_covariance(sw.footprint[None])  # 3 of (1, ns)
         cov_k = tuple(c[0] for c in cov)
@@ -365,9 +365,10 @@ class TextureTable:
                                           wf.crest_variance()[:, None], self.p.foam[im:im + 1].to(dtype)[:, None],
                                           trails=self.foam_trails)
             values.append((f_act + f_res)[0])
-        at = col * ns + row  # the visible samples in the (nt, ns) layout of the envelope
-        full = lambda v: v.new_zeros(nt * ns).index_put((at,), v).reshape(nt, ns)  # noqa: E731
-        return torch.stack([full(v) for v in values]), full(x_v), cov_k, m
+        # back to every sample (0 at the hidden ones), in the (nt, ns) layout of the envelope
+        full = x_v.new_zeros(len(values) + 1, nt, ns)
+        full[:, col, row] = torch.stack(values + [x_v])
+        return full[:-1], full[-1], cov_k, m
 
     def _row_statistics(self, sl: slice, wf: Any, gy: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor,
                         h: torch.Tensor, crest: bool) -> torch.Tensor:
