@@ -138,6 +138,29 @@ class Stages:
             wv.WaveField.sample_unchecked, tx.TextureTable._read_volume = sample, read
 
 
+def reading(results: dict, stages: dict, baseline: bool) -> list[str]:
+    """The report's reading, from the measured times (1 thread)."""
+    out = ["## Reading", ""]
+    for size in SIZES:
+        t = results[(1, size)]
+        total, st = stages[size]
+        n = st.size["ns"] * st.size["nt"]
+        reads = st.t["wave-field reads: elevation"] + st.t["wave-field reads: slopes (+ crest)"]
+        line = (f"- {size[0]}×{size[1]}, 1 thread: the first hit costs {t['first-hit'] / t['textured, flat point (default)']:.1f}× "
+                f"the default textured render and {t['first-hit'] / t['expectation']:.0f}× the expectation image")
+        if baseline:
+            line += f" (the baseline's: {t['first-hit, baseline'] / t['textured, flat point (default)']:.1f}×; "
+            line += f"{t['first-hit, baseline'] / t['first-hit']:.2f}× faster now)"
+        out.append(line + f". The sweep takes {n / (size[0] * size[1]):.0f} samples per pixel, "
+                   f"{1e9 * total / n:.0f} ns each all told, against "
+                   f"{1e9 * t['textured, flat point (default)'] / (size[0] * size[1]):.0f} ns per pixel for the whole "
+                   f"default render; the wave-field reads are {100 * reads / total:.0f} % of it.")
+    out += ["- The cost is the number of samples: the elevation at every one of them (the running horizon needs it) "
+            "and the slopes, crest variable, texture and foam at the visible ones. The coarser sweeps above trade "
+            "samples for accuracy against the ray tracer (docs/texture.md, the sweep).", ""]
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeats", type=int, default=5)
@@ -151,11 +174,13 @@ def main() -> None:
              f"One LWIR image, 10 m/s upwind, 15 m mast, pitch −6°, 12° field of view, float32, foam on; all "
              f"renders of a table timed in turn, median of {args.repeats}; "
              f"`python pipelines/bench_first_hit.py{' --baseline <main>' if base else ''}`", ""]
+    results = {}
     for threads in (1, 2):
         torch.set_num_threads(threads)
         for size in SIZES:
             fns = renders(size, base)
             t = timings(fns, args.repeats)
+            results[(threads, size)] = t
             lines += [f"{size[0]}×{size[1]}, {threads} thread{'s' if threads > 1 else ''}:", "",
                       "| render | time [s] | × expectation | × default textured |", "|---|---:|---:|---:|"]
             for k, v in t.items():
@@ -166,6 +191,7 @@ def main() -> None:
             lines.append("")
             print("\n".join(lines[-(len(t) + 4):]), file=sys.stderr)
     torch.set_num_threads(1)
+    stages = {}
     for size in SIZES:
         cams = rs.make_camera(*size, **CAMERA)
         f = lambda: rs.render(cams, rs.SeaScene(**SCENE), table=rs.TableSize(texture_hit="first"))  # noqa: E731
@@ -182,6 +208,8 @@ def main() -> None:
             lines.append(f"| {k} | {v:.3f} | {100 * v / total:.0f} % |")
         lines.append("")
         print("\n".join(lines[-(len(st.t) + 5):]), file=sys.stderr)
+        stages[size] = (total, st)
+    lines += reading(results, stages, base is not None)
     write_report(args.out, "bench_first_hit.md", "\n".join(lines) + "\n")
 
 
