@@ -28,7 +28,8 @@ from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
-from .hits import Sweep, pixel_hits, pixel_windows, sample_step, sweep_envelope, sweep_layout, visible_samples
+from .hits import (Sweep, flat_nonzero, pixel_hits, pixel_windows, sample_step, sweep_envelope, sweep_layout,
+                   visible_samples)
 from .path import path_rows
 from .scene import SceneParameters
 from .sky_terms import sky_per_image
@@ -344,30 +345,33 @@ class TextureTable:
         X, Y, t_s = sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1]
         eta = wf.sample_unchecked(X, Y, t_s, fp, elevation=True, crest=False, slopes=False)["elevation"]
         t, m = sweep_envelope(sw, eta[0].reshape(ns, nt))
-        row, col = visible_samples(m).T.nonzero().unbind(1)  # the visible samples, sample-major (ns, nt)
-        sel = row * nt + col
-        smp = wf.sample_unchecked(X[:, sel], Y[:, sel], t_s, fp[:, sel], elevation=False, crest=crest)
+        sel = flat_nonzero(visible_samples(m.T, dim=0))  # the visible samples, sample-major (ns, nt)
+        row = torch.div(sel, nt, rounding_mode="floor")
+        col = sel - row * nt
+        pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731  (faster than v[idx] on CPU)
+        Xv, Yv, fv = pick(X, sel)[None], pick(Y, sel)[None], pick(fp, sel)[None]
+        smp = wf.sample_unchecked(Xv, Yv, t_s, fv, elevation=False, crest=crest)
         cov = wf.resolved_covariance(sw.footprint[None])  # 3 of (1, ns)
         cov_k = tuple(c[0] for c in cov)
         cx, sx = torch.cos(sw.az), torch.sin(sw.az)  # the tracks' ray directions (camera → sea)
-        x_v = resolved_quantile(smp["slope_x"][0], smp["slope_y"][0], tuple(c[row] for c in cov_k), cx[col], sx[col])
+        x_v = resolved_quantile(smp["slope_x"][0], smp["slope_y"][0], tuple(pick(c, row) for c in cov_k), pick(cx, col),
+                                pick(sx, col))
         # each sample's row in the volume: ζ of its flat view zenith (the local vertical tilts by r/R)
         t0 = sw.flat_depression()
         cos_k = torch.sin(torch.atan(t0) + 2.0 * sw.curv * sw.r).clamp(1e-9, 1.0)
         zeta_k = torch.asinh(cos_k.double() / self.eps[im]).to(dtype)
-        gy = ((2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez))[row]
-        o = coordinate(cx[None, None, :], sx[None, None, :], i)[0, 0][col]
+        gy = pick((2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez), row)
+        o = pick(coordinate(cx[None, None, :], sx[None, None, :], i), col)
         values = [self._read_volume(vol[i:i + 1], x_v[None, None], o[None, None], gy[None, None], a[i:i + 1],
                                     b[i:i + 1])[0, 0, 0]]
         if crest:
-            var_r = wf.crest_variance(sw.footprint[None])[:, row]
-            f_act, f_res = whitecap_cover(wf, X[:, sel], Y[:, sel], t_s, fp[:, sel], smp["crest"], var_r,
-                                          wf.crest_variance()[:, None], self.p.foam[im:im + 1].to(dtype)[:, None],
-                                          trails=self.foam_trails)
+            var_r = pick(wf.crest_variance(sw.footprint[None]), row)[None]
+            f_act, f_res = whitecap_cover(wf, Xv, Yv, t_s, fv, smp["crest"], var_r, wf.crest_variance()[:, None],
+                                          self.p.foam[im:im + 1].to(dtype)[:, None], trails=self.foam_trails)
             values.append((f_act + f_res)[0])
         # back to every sample (0 at the hidden ones), in the (nt, ns) layout of the envelope
-        full = x_v.new_zeros(len(values) + 1, nt, ns)
-        full[:, col, row] = torch.stack(values + [x_v])
+        full = x_v.new_zeros(len(values) + 1, nt * ns).index_copy(1, col * ns + row, torch.stack(values + [x_v]))
+        full = full.reshape(-1, nt, ns)
         return full[:-1], full[-1], cov_k, m
 
     def _row_statistics(self, sl: slice, wf: Any, gy: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor,

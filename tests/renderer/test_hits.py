@@ -179,6 +179,7 @@ def test_visible_samples_hold_every_point_a_ray_reaches():
     assert bool(vis[seen].all())
     assert bool((seen | torch.roll(seen, -1))[vis].all())
     assert float((~vis).double().mean()) > 0.05  # the shadows behind the crests (13 %)
+    assert torch.equal(visible_samples(m.T, dim=0).T, visible_samples(m))  # the samples' axis first: the same
 
 
 def test_pixel_hits_is_the_average_and_the_centre_hit_of_one_search():
