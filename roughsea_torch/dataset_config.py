@@ -106,7 +106,7 @@ def resolve_config(config: dict[str, Any]) -> dict[str, Any]:
     ``motion`` table (ranges of the platform's oscillations for clips, keys of
     :data:`~roughsea_torch.sampling.MOTION_FIELDS`: amplitudes [deg], [m], periods [s]). The
     ``render`` table: ``texture_hit`` (``"flat"``, default, or ``"first"``: the sweep near grazing,
-    about 10× the time), ``texture_antialias`` (default true), ``glitter`` (default false: MWIR
+    7–18× the time of a flat-point image), ``texture_antialias`` (default true), ``glitter`` (default false: MWIR
     glitter by day) and ``foam_trails`` (default false: residual foam drifting and fading), the :class:`~roughsea_torch.renderer.TableSize` fields of the same names.
     Day images: ``scene.daytime`` (probability in [0, 1] that an item is by day, default 0.0: all
     by night, no sun drawn), ``scene.sun_elevation_deg`` (range [deg] within [0, 90], default

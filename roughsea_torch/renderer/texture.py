@@ -28,7 +28,8 @@ from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
-from .hits import Sweep, centre_element, pixel_windows, sample_step, sweep_envelope, sweep_layout, visible_average
+from .hits import (Sweep, flat_nonzero, pixel_hits, pixel_windows, sample_step, sweep_envelope, sweep_layout,
+                   visible_samples)
 from .path import path_rows
 from .scene import SceneParameters
 from .sky_terms import sky_per_image
@@ -322,12 +323,11 @@ class TextureTable:
             values, x_k, cov_k, m = self._swept_samples(im, i, wf, sw, vol, lo, span_z, a, b, coordinate, crest)
             j = ((phi.detach() - sw.p0) / sw.dphi).round().clamp(0, sw.az.shape[0] - 1).long()
             tau_t, tau_b = pixel_windows(tan_g, float(self.ifov[im]))
-            avg = visible_average(m, values, j, tau_t, tau_b)
+            avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g)
             texture[i] = texture[i].index_put((s,), avg[0])
             if crest:
                 f_pix[i] = f_pix[i].index_put((s,), avg[1])
-            k, hit = centre_element(m, j, tan_g)
-            x_c[i] = x_c[i].index_put((s,), torch.where(hit, x_k.T[j, k], torch.zeros_like(tan_g)))
+            x_c[i] = x_c[i].index_put((s,), torch.where(hit, x_k[j, k], torch.zeros_like(tan_g)))
             for c in range(3):
                 cov_c[c][i] = cov_c[c][i].index_put((s,), cov_k[c][k])
         return texture, (x_c, x_c), tuple(cov_c), f_pix
@@ -335,33 +335,44 @@ class TextureTable:
     def _swept_samples(self, im: int, i: int, wf: Any, sw: Sweep, vol: torch.Tensor, lo: torch.Tensor,
                        span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any, crest: bool) -> tuple:
         """At the sweep's samples of image ``im`` (chunk index ``i``): the texture and foam fraction
-        (C, nt, ns), the resolved quantiles x (ns, nt), the resolved covariance (3 of (ns,)) and the
-        running minimum m (nt, ns) of the envelope."""
+        (C, nt, ns), the resolved quantiles x (nt, ns), the resolved covariance (3 of (ns,)) and the
+        running minimum m (nt, ns) of the envelope. The elevation is read at every sample; the slopes,
+        the crest variable, the texture and the foam only at the visible ones (:func:`visible_samples`:
+        about half near grazing), 0 at the hidden ones, which no pixel sees."""
         dtype = self.dtype
         ns, nt = sw.shape
         fp = sw.footprint[:, None].expand(ns, nt).reshape(1, -1)
-        smp = wf.sample_unchecked(sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1], fp, elevation=True,
-                                  crest=crest)
-        t, m = sweep_envelope(sw, smp["elevation"][0].reshape(ns, nt))
+        X, Y, t_s = sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1]
+        eta = wf.sample_unchecked(X, Y, t_s, fp, elevation=True, crest=False, slopes=False)["elevation"]
+        t, m = sweep_envelope(sw, eta[0].reshape(ns, nt))
+        sel = flat_nonzero(visible_samples(m.T, dim=0))  # the visible samples, sample-major (ns, nt)
+        row = torch.div(sel, nt, rounding_mode="floor")
+        col = sel - row * nt
+        pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731  (faster than v[idx] on CPU)
+        Xv, Yv, fv = pick(X, sel)[None], pick(Y, sel)[None], pick(fp, sel)[None]
+        smp = wf.sample_unchecked(Xv, Yv, t_s, fv, elevation=False, crest=crest)
         cov = wf.resolved_covariance(sw.footprint[None])  # 3 of (1, ns)
         cov_k = tuple(c[0] for c in cov)
         cx, sx = torch.cos(sw.az), torch.sin(sw.az)  # the tracks' ray directions (camera → sea)
-        x_k = resolved_quantile(smp["slope_x"][0].reshape(ns, nt), smp["slope_y"][0].reshape(ns, nt),
-                                tuple(c[:, None] for c in cov_k), cx[None, :], sx[None, :])
+        x_v = resolved_quantile(smp["slope_x"][0], smp["slope_y"][0], tuple(pick(c, row) for c in cov_k), pick(cx, col),
+                                pick(sx, col))
         # each sample's row in the volume: ζ of its flat view zenith (the local vertical tilts by r/R)
         t0 = sw.flat_depression()
         cos_k = torch.sin(torch.atan(t0) + 2.0 * sw.curv * sw.r).clamp(1e-9, 1.0)
         zeta_k = torch.asinh(cos_k.double() / self.eps[im]).to(dtype)
-        gy = ((2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez))[:, None].expand(ns, nt)
-        o = coordinate(cx[None, None, :], sx[None, None, :], i)[0].expand(ns, nt)
-        values = [self._read_volume(vol[i:i + 1], x_k[None], o[None], gy[None], a[i:i + 1], b[i:i + 1])[0, 0]]
+        gy = pick((2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez), row)
+        o = pick(coordinate(cx[None, None, :], sx[None, None, :], i), col)
+        values = [self._read_volume(vol[i:i + 1], x_v[None, None], o[None, None], gy[None, None], a[i:i + 1],
+                                    b[i:i + 1])[0, 0, 0]]
         if crest:
-            var_r = wf.crest_variance(sw.footprint[None])[:, :, None].expand(1, ns, nt).reshape(1, -1)
-            f_act, f_res = whitecap_cover(wf, sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1], fp,
-                                          smp["crest"], var_r, wf.crest_variance()[:, None],
+            var_r = pick(wf.crest_variance(sw.footprint[None]), row)[None]
+            f_act, f_res = whitecap_cover(wf, Xv, Yv, t_s, fv, smp["crest"], var_r, wf.crest_variance()[:, None],
                                           self.p.foam[im:im + 1].to(dtype)[:, None], trails=self.foam_trails)
-            values.append((f_act + f_res)[0].reshape(ns, nt))
-        return torch.stack([v.T for v in values]), x_k, cov_k, m
+            values.append((f_act + f_res)[0])
+        # back to every sample (0 at the hidden ones), in the (nt, ns) layout of the envelope
+        full = x_v.new_zeros(len(values) + 1, nt * ns).index_copy(1, col * ns + row, torch.stack(values + [x_v]))
+        full = full.reshape(-1, nt, ns)
+        return full[:-1], full[-1], cov_k, m
 
     def _row_statistics(self, sl: slice, wf: Any, gy: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor,
                         h: torch.Tensor, crest: bool) -> torch.Tensor:
