@@ -19,13 +19,15 @@ s = (P + Q)/2, d = (P − Q)/2,
 
     f = 0 (t ≤ −s),  (t + s)²/(2PQ) (−s < t ≤ −d),  ½ + t/P (|t| < d),  1 − (s − t)²/(2PQ) (d ≤ t < s),  1 (t ≥ s).
 
-Values. The sky value of a straddling pixel is what its centre ray sees if that is sky, else the
-value of its neighbour one pixel towards the sky; the sea value likewise (the neighbour one pixel
-towards the sea: along the image axis on which g changes most, so its centre lies on the other
-side of the horizon). A sea value from the neighbour is evaluated one pixel further below the
-horizon than the pixel's own sea part (the approximation of this module; ``docs/architecture.md``).
-Radiances are mixed; brightness temperatures are mixed as the radiances they stand for.
-Pixels the horizon does not cross are returned bit for bit.
+Values. Along the image axis on which g changes most, the two nearest pixel centres on the sea
+side (the pixel's own if it is sea, and the next; else its two neighbours towards the sea, whose
+centres are sea since the line crosses the square) give the sea value at the centroid of the
+pixel's sea part by linear inter- or extrapolation along that axis; the sky value likewise at the
+sky part's centroid (centroids taken along the axis, from the horizon's offset g/|∂g| at the
+centre). Near the image's edge, with one centre only, that centre's value. The values come from
+the centre-ray render: a profile that changes within the pixel nearest the horizon is not
+resolved (``docs/scenes.md``). Radiances are mixed; brightness temperatures as the radiances they
+stand for. Pixels the horizon does not cross are returned bit for bit.
 """
 
 from __future__ import annotations
@@ -158,15 +160,14 @@ def blend_horizon(img: torch.Tensor, cg: CameraGeometry, band: SpectralBand | No
         to_sea = -torch.where(along_v, q, p).sign().long()  # index step towards the sea (g falls)
         dv, du = torch.where(along_v, to_sea, 0), torch.where(along_v, 0, to_sea)
 
-        def at(k: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:  # the pixel k steps towards the sea
+        def inside(k: torch.Tensor) -> torch.Tensor:  # whether the pixel k steps towards the sea is in the image
             vv, uu = v + k * dv, u + k * du
-            inside = (vv >= 0) & (vv < H) & (uu >= 0) & (uu < W)
-            return inside, im[bi, vv.clamp(0, H - 1), uu.clamp(0, W - 1)]
+            return (vv >= 0) & (vv < H) & (uu >= 0) & (uu < W)
 
         one = torch.ones_like(v)
         ks0, ks1 = torch.where(sea_c, 0, one), torch.where(sea_c, one, 2 * one)  # sea centres used
         kk0, kk1 = torch.where(sea_c, -one, 0), torch.where(sea_c, -2 * one, -one)  # sky centres used
-        (i_s0, _), (i_s1, _), (i_k0, _), (i_k1, _) = at(ks0), at(ks1), at(kk0), at(kk1)
+        i_s0, i_s1, i_k0, i_k1 = inside(ks0), inside(ks1), inside(kk0), inside(kk1)
         ok = (to_sea != 0) & i_s0 & i_k0
     # values at the centres (differentiable: gathered from img), interpolated or extrapolated
     # linearly along the axis to the centroids (a constant where the second centre is off the image)
