@@ -120,7 +120,8 @@ def horizon_pixels(cg: CameraGeometry) -> tuple[torch.Tensor, torch.Tensor, torc
     likewise by rows. No gradient; (n,) each, sorted."""
     H, W = cg.H, cg.W
     with torch.no_grad():
-        K = cg.cameras.camera_matrix[:, :3, :3].double()
+        K = cg.cameras.camera_matrix[:, :3, :3].double().clone()
+        K[:, 0, 1] = 0.0  # the rays of kornia's normalization (the renderer's), which ignores a skew
         Kinv = torch.linalg.inv(K)
         n = cg.axes_cam[:, 2].double()
         sh = torch.zeros(K.shape[0], dtype=torch.float64, device=K.device) if cg.flat else cg.s_h.double()
