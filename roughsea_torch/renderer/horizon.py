@@ -139,6 +139,44 @@ def horizon_pixels(cg: CameraGeometry) -> tuple[torch.Tensor, torch.Tensor, torc
         return idx // (H * W), (idx // W) % H, idx % W
 
 
+def _side_values(im: torch.Tensor, bi: torch.Tensor, v: torch.Tensor, u: torch.Tensor, g0: torch.Tensor,
+                 gd: torch.Tensor, along_v: bool) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The sea and sky values of the pixels (bi, v, u) from the centres along one image axis (rows
+    with ``along_v``, else columns), g changing by ``gd`` a pixel along it: each part's value at its
+    centroid along the axis, linearly inter/extrapolated from the two nearest centres on its side
+    (module docstring); and whether the axis serves (both nearest centres in the image and, by the
+    line, on their side)."""
+    H, W = im.shape[1:]
+    a = gd.abs().clamp_min(1e-30)
+    # the horizon's offset from the centre towards the sea [px], and the two parts' centroids
+    w_h = (g0 / a).clamp(-0.5, 0.5)
+    w_c, w_k = 0.5 * (w_h + 0.5), 0.5 * (w_h - 0.5)
+    with torch.no_grad():
+        sea_c = g0 < 0
+        to_sea = -gd.sign().long()  # index step towards the sea (g falls)
+        dv, du = (to_sea, torch.zeros_like(to_sea)) if along_v else (torch.zeros_like(to_sea), to_sea)
+        one = torch.ones_like(v)
+        ks0, ks1 = torch.where(sea_c, 0, one), torch.where(sea_c, one, 2 * one)  # sea centres used
+        kk0, kk1 = torch.where(sea_c, -one, 0), torch.where(sea_c, -2 * one, -one)  # sky centres used
+
+        def inside(k: torch.Tensor) -> torch.Tensor:
+            vv, uu = v + k * dv, u + k * du
+            return (vv >= 0) & (vv < H) & (uu >= 0) & (uu < W)
+
+        ok = (to_sea != 0) & inside(ks0) & inside(kk0) & (g0 - ks0 * a < 0) & (g0 - kk0 * a >= 0)
+        i_s1, i_k1 = inside(ks1), inside(kk1)
+
+    def at(k: torch.Tensor) -> torch.Tensor:  # differentiable: gathered from the image
+        return im[bi, (v + k * dv).clamp(0, H - 1), (u + k * du).clamp(0, W - 1)]
+
+    vs0, vs1, vk0, vk1 = at(ks0), at(ks1), at(kk0), at(kk1)
+    # (held above half the smaller sample: a sun's disk in the farther sample cannot drive the
+    # extrapolated value negative)
+    sea = (vs0 + torch.where(i_s1, w_c - ks0, 0.0) * (vs1 - vs0)).maximum(0.5 * torch.minimum(vs0, vs1))
+    sky = (vk0 + torch.where(i_k1, kk0 - w_k, 0.0) * (vk1 - vk0)).maximum(0.5 * torch.minimum(vk0, vk1))
+    return sea, sky, ok
+
+
 def blend_horizon(img: torch.Tensor, cg: CameraGeometry, band: SpectralBand | None = None) -> torch.Tensor:
     """``img`` (B, 1, H, W) or (B, H, W), rendered by centre rays, with the pixels the horizon
     crosses replaced by f · sea + (1 − f) · sky (module docstring); in kelvin when ``band`` is
@@ -148,43 +186,24 @@ def blend_horizon(img: torch.Tensor, cg: CameraGeometry, band: SpectralBand | No
     bi, v, u = horizon_pixels(cg)
     if bi.numel() == 0:
         return img
-    H, W = im.shape[1:]
     f, g0, p, q = sea_fraction(cg, bi, v, u)
-    along_v = q.detach().abs() >= p.detach().abs()  # the axis along which g changes most
-    gd = torch.where(along_v, q, p)
-    # the horizon's offset from the centre along that axis, towards the sea [px], and the centroids
-    # of the pixel's sea part (w_c ∈ [0, ½]) and sky part (w_k ∈ [−½, 0]) along it
-    w_h = (g0 / gd.abs().clamp_min(1e-30)).clamp(-0.5, 0.5)
-    w_c, w_k = 0.5 * (w_h + 0.5), 0.5 * (w_h - 0.5)
-    with torch.no_grad():
-        sea_c = g0 < 0
-        to_sea = -torch.where(along_v, q, p).sign().long()  # index step towards the sea (g falls)
-        dv, du = torch.where(along_v, to_sea, 0), torch.where(along_v, 0, to_sea)
-
-        def inside(k: torch.Tensor) -> torch.Tensor:  # whether the pixel k steps towards the sea is in the image
-            vv, uu = v + k * dv, u + k * du
-            return (vv >= 0) & (vv < H) & (uu >= 0) & (uu < W)
-
-        one = torch.ones_like(v)
-        ks0, ks1 = torch.where(sea_c, 0, one), torch.where(sea_c, one, 2 * one)  # sea centres used
-        kk0, kk1 = torch.where(sea_c, -one, 0), torch.where(sea_c, -2 * one, -one)  # sky centres used
-        i_s0, i_s1, i_k0, i_k1 = inside(ks0), inside(ks1), inside(kk0), inside(kk1)
-        ok = (to_sea != 0) & i_s0 & i_k0
-    # values at the centres (differentiable: gathered from img), interpolated or extrapolated
-    # linearly along the axis to the centroids (a constant where the second centre is off the image)
-    vs0, vs1 = (im[bi, (v + k * dv).clamp(0, H - 1), (u + k * du).clamp(0, W - 1)] for k in (ks0, ks1))
-    vk0, vk1 = (im[bi, (v + k * dv).clamp(0, H - 1), (u + k * du).clamp(0, W - 1)] for k in (kk0, kk1))
-    # (held above half the smaller sample: a sun's disk in the farther sample cannot drive the
-    # extrapolated value negative)
-    sea = (vs0 + torch.where(i_s1, w_c - ks0, 0.0) * (vs1 - vs0)).maximum(0.5 * torch.minimum(vs0, vs1))
-    sky = (vk0 + torch.where(i_k1, kk0 - w_k, 0.0) * (vk1 - vk0)).maximum(0.5 * torch.minimum(vk0, vk1))
+    sea_v, sky_v, ok_v = _side_values(im, bi, v, u, g0, q, True)
+    sea_u, sky_u, ok_u = _side_values(im, bi, v, u, g0, p, False)
+    # the weight of the rows' estimate: 1 where g changes faster along the rows by 20 % of the sum,
+    # 0 the other way, linear between (no jump where the horizon's slope passes 45°); one axis
+    # alone where the other does not serve
+    w = (0.5 + (q.abs() - p.abs()) / (0.2 * (p.abs() + q.abs()).clamp_min(1e-30))).clamp(0.0, 1.0)
+    w = torch.where(ok_v & ~ok_u, 1.0, torch.where(ok_u & ~ok_v, 0.0, w))
+    sea = w * sea_v + (1 - w) * sea_u
+    sky = w * sky_v + (1 - w) * sky_u
     if band is not None:
         mixed = brightness_temperature(f * band_radiance(sea, band) + (1 - f) * band_radiance(sky, band), band)
     else:
         mixed = f * sea + (1 - f) * sky
     own = im[bi, v, u]
-    # a pixel whose square lies wholly on its centre's side (or whose neighbours are off the image)
-    # keeps its value exactly
-    keep = ~ok | (f == 1) & sea_c | (f == 0) & ~sea_c
+    sea_c = g0.detach() < 0
+    # a pixel whose square lies wholly on its centre's side (or with no centres to use) keeps its
+    # value exactly
+    keep = ~(ok_v | ok_u) | (f == 1) & sea_c | (f == 0) & ~sea_c
     out = im.index_put((bi, v, u), torch.where(keep, own, mixed.to(im.dtype)))
     return out[:, None] if squeeze else out
