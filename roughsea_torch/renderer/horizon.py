@@ -19,8 +19,9 @@ s = (P + Q)/2, d = (P − Q)/2,
 
     f = 0 (t ≤ −s),  (t + s)²/(2PQ) (−s < t ≤ −d),  ½ + t/P (|t| < d),  1 − (s − t)²/(2PQ) (d ≤ t < s),  1 (t ≥ s).
 
-Values. Along the image axis on which g changes most, the two nearest pixel centres on the sea
-side (the pixel's own if it is sea, and the next; else its two neighbours towards the sea, whose
+Values. Along the image axis on which g changes most (both axes, weighted, where the horizon's
+slope is within a few degrees of 45°, so that the choice does not jump), the two nearest pixel
+centres on the sea side (the pixel's own if it is sea, and the next; else its two neighbours towards the sea, whose
 centres are sea since the line crosses the square) give the sea value at the centroid of the
 pixel's sea part by linear inter- or extrapolation along that axis; the sky value likewise at the
 sky part's centroid (centroids taken along the axis, from the horizon's offset g/|∂g| at the
