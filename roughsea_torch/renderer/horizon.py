@@ -141,9 +141,9 @@ def horizon_pixels(cg: CameraGeometry) -> tuple[torch.Tensor, torch.Tensor, torc
 
 
 def _side_values(im: torch.Tensor, bi: torch.Tensor, v: torch.Tensor, u: torch.Tensor, g0: torch.Tensor,
-                 gd: torch.Tensor, along_v: bool) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """The sea and sky values of the pixels (bi, v, u) from the centres along one image axis (rows
-    with ``along_v``, else columns), g changing by ``gd`` a pixel along it: each part's value at its
+                 gd: torch.Tensor, along_v: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The sea and sky values of the pixels (bi, v, u) from the centres along one image axis each
+    (rows where ``along_v``, else columns), g changing by ``gd`` a pixel along it: each part's value at its
     centroid along the axis, linearly inter/extrapolated from the two nearest centres on its side
     (module docstring); and whether the axis serves (both nearest centres in the image and, by the
     line, on their side)."""
@@ -155,7 +155,7 @@ def _side_values(im: torch.Tensor, bi: torch.Tensor, v: torch.Tensor, u: torch.T
     with torch.no_grad():
         sea_c = g0 < 0
         to_sea = -gd.sign().long()  # index step towards the sea (g falls)
-        dv, du = (to_sea, torch.zeros_like(to_sea)) if along_v else (torch.zeros_like(to_sea), to_sea)
+        dv, du = torch.where(along_v, to_sea, 0), torch.where(along_v, 0, to_sea)
         one = torch.ones_like(v)
         ks0, ks1 = torch.where(sea_c, 0, one), torch.where(sea_c, one, 2 * one)  # sea centres used
         kk0, kk1 = torch.where(sea_c, -one, 0), torch.where(sea_c, -2 * one, -one)  # sky centres used
@@ -188,8 +188,10 @@ def blend_horizon(img: torch.Tensor, cg: CameraGeometry, band: SpectralBand | No
     if bi.numel() == 0:
         return img
     f, g0, p, q = sea_fraction(cg, bi, v, u)
-    sea_v, sky_v, ok_v = _side_values(im, bi, v, u, g0, q, True)
-    sea_u, sky_u, ok_u = _side_values(im, bi, v, u, g0, p, False)
+    n = bi.shape[0]
+    axis = torch.arange(2 * n, device=bi.device) < n  # both axes in one pass: rows, then columns
+    sea2, sky2, ok2 = _side_values(im, bi.repeat(2), v.repeat(2), u.repeat(2), g0.repeat(2), torch.cat([q, p]), axis)
+    (sea_v, sea_u), (sky_v, sky_u), (ok_v, ok_u) = sea2.split(n), sky2.split(n), ok2.split(n)
     # the weight of the rows' estimate: 1 where g changes faster along the rows by 20 % of the sum,
     # 0 the other way, linear between (no jump where the horizon's slope passes 45°); one axis
     # alone where the other does not serve
