@@ -29,6 +29,7 @@ from .._parallel import one_thread
 from ..expectation import Quadrature
 from ..geometry import EARTH_RADIUS_M, CameraGeometry, ViewGeometry
 from .direct import render_direct
+from .horizon import blend_horizon
 from .plan import make_plan
 from .scene import SeaScene
 from .settings import TableSize, images_per_chunk
@@ -48,6 +49,7 @@ def render(
     quadrature: Quadrature | None = None,
     geometry: ViewGeometry | None = None,
     chunk: int | None = None,
+    horizon: str = "area",
 ) -> torch.Tensor:
     """Render infrared images of the sea seen by a batch of kornia cameras.
 
@@ -64,6 +66,11 @@ def render(
         chunk: images whose per-pixel temporaries are held at once (memory bound; results do not
             depend on it), an int ≥ 1 (else a ``ValueError``); default 4, and 1 for textured scenes
             (``seed=``), whose per-pixel work holds a dozen more full-size temporaries.
+        horizon: ``"area"`` (default): a pixel the horizon crosses reads the mix of sea and sky
+            weighted by the areas of its square below and above the horizon
+            (:mod:`~roughsea_torch.renderer.horizon`); ``"centre"``: every pixel what its centre
+            ray sees (a one-pixel step at the horizon). Sea masks (``view_geometry``) stay by the
+            centre ray either way.
 
     Returns:
         (B, 1, H, W) tensor in the cameras' dtype and device; differentiable with respect to every
@@ -78,7 +85,7 @@ def render(
     # (roughsea_torch._parallel); larger batches spread their chunks over worker threads instead
     def call() -> torch.Tensor:
         return _render(cameras, scene, earth_radius_m=earth_radius_m, method=method, output=output, table=table,
-                       quadrature=quadrature, geometry=geometry, chunk=chunk)
+                       quadrature=quadrature, geometry=geometry, chunk=chunk, horizon=horizon)
 
     ref = geometry.cos_view_zenith if geometry is not None else getattr(cameras, "intrinsics", None)
     per_chunk = images_per_chunk(scene, chunk)
@@ -90,10 +97,13 @@ def render(
 
 
 def _render(cameras: PinholeCamera, scene: SeaScene, *, earth_radius_m: float, method: str, output: str,
-            table: TableSize, quadrature: Quadrature | None, geometry: ViewGeometry | None, chunk: int | None) -> torch.Tensor:
-    """:func:`render`'s body: checks, the scene's per-image values, then the method."""
+            table: TableSize, quadrature: Quadrature | None, geometry: ViewGeometry | None, chunk: int | None,
+            horizon: str = "area") -> torch.Tensor:
+    """:func:`render`'s body: checks, the scene's per-image values, the method, the horizon's pixels."""
     if method not in ("table", "direct"):
         raise ValueError(f"method must be 'table' or 'direct'; got {method!r}")
+    if horizon not in ("area", "centre"):
+        raise ValueError(f"horizon must be 'area' or 'centre'; got {horizon!r}")
     chunk = images_per_chunk(scene, chunk)
     if output not in ("radiance", "brightness_temperature"):
         raise ValueError(f"output must be 'radiance' or 'brightness_temperature'; got {output!r}")
@@ -107,14 +117,19 @@ def _render(cameras: PinholeCamera, scene: SeaScene, *, earth_radius_m: float, m
         B, H, W, dtype, device = cg.batch_size, cg.H, cg.W, cg.dtype, cg.device
     p = scene.resolved(B, dtype, device)
     q = quadrature or Quadrature.default(dtype)
-    if method == "direct":
-        return render_direct(cameras, geometry, scene, p, q, earth_radius_m, brightness, table)
     if geometry is not None:
         altitude, radius = geometry.altitude_m, getattr(geometry, "earth_radius_m", earth_radius_m)
     else:
         altitude, radius = cg.alt.to(dtype), earth_radius_m
-    plan = make_plan(cg, geometry, B, H, W, dtype, device, p, scene, q, table, chunk, altitude, radius, brightness)
-    return render_table(plan)[:, None]
+    if method == "direct":
+        img = render_direct(cameras, geometry, scene, p, q, earth_radius_m, brightness, table)
+    else:
+        plan = make_plan(cg, geometry, B, H, W, dtype, device, p, scene, q, table, chunk, altitude, radius, brightness)
+        img = render_table(plan)[:, None]
+    if horizon == "centre" or not isinstance(cameras, PinholeCamera):
+        return img
+    cg = cg if cg is not None else CameraGeometry(cameras, radius)
+    return blend_horizon(img, cg, scene.band if brightness else None)
 
 
 class SeaRenderer(torch.nn.Module):
@@ -127,8 +142,10 @@ class SeaRenderer(torch.nn.Module):
         output: str = "radiance",
         table: TableSize = TableSize(),
         quadrature: Quadrature | None = None,
+        horizon: str = "area",
     ):
         super().__init__()
+        self.horizon = horizon
         self.earth_radius_m = earth_radius_m
         self.method = method
         self.output = output
@@ -138,9 +155,9 @@ class SeaRenderer(torch.nn.Module):
     def forward(self, cameras: PinholeCamera, scene: SeaScene) -> torch.Tensor:
         return render(
             cameras, scene, earth_radius_m=self.earth_radius_m, method=self.method, output=self.output,
-            table=self.table, quadrature=self.quadrature,
+            table=self.table, quadrature=self.quadrature, horizon=self.horizon,
         )
 
     def extra_repr(self) -> str:
-        return f"earth_radius_m={self.earth_radius_m}, method={self.method!r}, output={self.output!r}, table={self.table}"
+        return f"earth_radius_m={self.earth_radius_m}, method={self.method!r}, output={self.output!r}, table={self.table}, horizon={self.horizon!r}"
 

@@ -29,8 +29,9 @@ def test_path_composes_transmittance_and_path_radiance_per_pixel():
     cams = make_cams(40, 48, hfov_deg=3.0, pitch_deg=-0.5)
     geom = rs.view_geometry(cams)
     base = dict(wind_speed=6.0, sea_temperature=285.0, sky=smooth_sky)
-    off = rs.render(cams, rs.SeaScene(**base, path=False), geometry=geom)
-    on = rs.render(cams, rs.SeaScene(**base, path=BeerLambertPath(295.0)), geometry=geom)
+    # per ray: each pixel by its centre ray (the horizon's area-weighted pixels mix two rays)
+    off = rs.render(cams, rs.SeaScene(**base, path=False), geometry=geom, horizon="centre")
+    on = rs.render(cams, rs.SeaScene(**base, path=BeerLambertPath(295.0)), geometry=geom, horizon="centre")
     tau = torch.exp(-geom.range_m / 5000.0)[:, None]
     sea = geom.is_sea[:, None]
     expected = tau * off + (1 - tau) * float(rs.band_radiance(torch.tensor(295.0, dtype=torch.float64)))
