@@ -344,7 +344,7 @@ def test_texture_table_returns_the_pixels_crest(monkeypatch):
         finally:
             self.p.foam = foam
         assert len(result) == 4 and result[3] is not None
-        captured.append(result[3])
+        captured.append(result[3][0] + result[3][1])  # the active and residual covers
         return result[:3] + (None,)
 
     monkeypatch.setattr(TextureTable, "pixels", with_crest)
