@@ -222,7 +222,9 @@ def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tens
                    crest_now: torch.Tensor, resolved_variance: torch.Tensor, total_variance: torch.Tensor,
                    whitecap_fraction: torch.Tensor, decay_s: float = RESIDUAL_DECAY_S,
                    trails: bool = True) -> tuple[torch.Tensor, torch.Tensor]:
-    """The active and residual foam cover (a B, (1 − a) R) of points of a wave field (module docstring).
+    """The active and residual foam cover (a B, (1 − a) R) of points of a wave field (module docstring),
+    each indicator thresholding the crest variable plus the drifting streak field
+    (:mod:`~roughsea_torch.foam_streaks`, resolved as the footprint allows).
 
     Args:
         wf: the :class:`~roughsea_torch.waves.WaveField` (B images).
