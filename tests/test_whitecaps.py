@@ -191,9 +191,9 @@ def test_foam_state_gradients_are_finite():
 def test_textured_ensemble_mean_weights_the_two_states_as_the_expectation(monkeypatch):
     """With an exaggerated skin deficit (4 K, so that the states differ by ~4 % of the radiance), the
     mean over 12 realizations of a 20 m/s storm's sea pixels (default covers, no trails) equals the
-    expectation image's, whose foam is a R_act + (1 − a) R_res, within 1e-3 (measured 4.3e-5; the sampling error of the
-    test above); an expectation with the residual's radiance alone is 4e-3 off (planted: a = 0 in
-    renderer.foam_terms.active_share_of_images fails)."""
+    expectation image's, whose foam is a R_act + (1 − a) R_res, within 1e-3 (measured 4.3e-5; the
+    sampling error of the test above); an expectation with the residual's radiance alone is 4e-3 off
+    (planted: a = 0 in renderer.foam_terms.active_share_of_images fails)."""
     from roughsea_torch.renderer import foam_terms
 
     monkeypatch.setattr(foam_terms, "SKIN_DEFICIT_K", 4.0)
