@@ -93,23 +93,22 @@ def streak_noise(x: torch.Tensor, y: torch.Tensor, seeds: Sequence[int], cos_win
         ν (B, ...), exactly N(0, 1) at every point for a random seed; continuous; differentiable in
         x, y, the direction and the lengths (not in the node values).
     """
-    extra = (None,) * (x.ndim - 1)
     base = _mix(torch.tensor([int(sd) for sd in seeds], dtype=torch.int64, device=x.device) * 0x5DEECE66D + 17)
-    per_image = [base, cos_wind, sin_wind, length_along, length_across]
-    per_image = [t[(...,) + extra].expand(x.shape) for t in per_image]
-    xd, yd = x.to(torch.float64), y.to(torch.float64)
-    if where is not None:
-        xd, yd = xd[where], yd[where]
-        per_image = [t[where] for t in per_image]
-    b, c, s, la, lc = per_image[0], *(t.to(torch.float64) for t in per_image[1:])
-    u = (xd * c + yd * s) / la
-    v = (yd * c - xd * s) / lc
-    iu, iv = torch.floor(u.detach()), torch.floor(v.detach())
-    fu, fv = u - iu, v - iv
-    wu = (torch.cos(0.5 * math.pi * fu), torch.sin(0.5 * math.pi * fu))
-    wv = (torch.cos(0.5 * math.pi * fv), torch.sin(0.5 * math.pi * fv))
-    i0, j0 = iu.to(torch.int64), iv.to(torch.int64)
-    nu = sum(wu[p] * wv[q] * _node_normal(b, i0 + p, j0 + q) for p in (0, 1) for q in (0, 1)).to(x.dtype)
-    if where is None:
-        return nu
-    return torch.zeros_like(x).index_put((where,), nu)
+    # image by image: the transcendental functions' vectorized and scalar paths round differently, and
+    # image i of a batch must be bitwise the image rendered alone (its elements in the same places)
+    out = []
+    for i in range(x.shape[0]):
+        xd, yd = x[i].to(torch.float64), y[i].to(torch.float64)
+        if where is not None:
+            xd, yd = xd[where[i]], yd[where[i]]
+        c, s, la, lc = (t[i].to(torch.float64) for t in (cos_wind, sin_wind, length_along, length_across))
+        u = (xd * c + yd * s) / la
+        v = (yd * c - xd * s) / lc
+        iu, iv = torch.floor(u.detach()), torch.floor(v.detach())
+        fu, fv = u - iu, v - iv
+        wu = (torch.cos(0.5 * math.pi * fu), torch.sin(0.5 * math.pi * fu))
+        wv = (torch.cos(0.5 * math.pi * fv), torch.sin(0.5 * math.pi * fv))
+        i0, j0 = iu.to(torch.int64), iv.to(torch.int64)
+        nu = sum(wu[p] * wv[q] * _node_normal(base[i], i0 + p, j0 + q) for p in (0, 1) for q in (0, 1)).to(x.dtype)
+        out.append(nu if where is None else torch.zeros_like(x[i]).index_put((where[i],), nu))
+    return torch.stack(out)

@@ -161,8 +161,8 @@ def skin_disrupted_radiance(sea_radiance: torch.Tensor, band: Any, deficit_k: fl
 
 
 def foam_state_radiances(view_zenith: torch.Tensor, band: Any, sea_radiance: torch.Tensor, sky: torch.Tensor,
-                         refractive_index: Any = None,
-                         deficit_k: float = SKIN_DEFICIT_K) -> tuple[torch.Tensor, torch.Tensor]:
+                         refractive_index: Any = None, deficit_k: float = SKIN_DEFICIT_K,
+                         bulk_radiance: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
     """(R_act, R_res) [W m⁻² sr⁻¹]: active foam ε_f R_B(T + ΔT_skin) + (1 − ε_f) S and residual foam
     ε_f R_B(T) + (1 − ε_f) S (module docstring; ε_f, S: :func:`~roughsea_torch.foam.foam_radiance`).
 
@@ -171,6 +171,7 @@ def foam_state_radiances(view_zenith: torch.Tensor, band: Any, sea_radiance: tor
         sea_radiance: R_B(T) of the skin [W m⁻² sr⁻¹] > 0; sky: S, the sky the foam reflects, ≥ 0.
         refractive_index: the water's (see :func:`~roughsea_torch.foam.foam_emissivity`).
         deficit_k: ΔT_skin [K] ≥ 0.
+        bulk_radiance: R_B(T + ΔT_skin) if already computed (:func:`skin_disrupted_radiance`), else None.
     All broadcast together; float32/float64 and device follow the inputs.
 
     Returns:
@@ -179,8 +180,8 @@ def foam_state_radiances(view_zenith: torch.Tensor, band: Any, sea_radiance: tor
     if not (isinstance(deficit_k, (int, float)) and math.isfinite(deficit_k) and 0.0 <= deficit_k <= 5.0):
         raise ValueError(f"deficit_k must be a skin temperature deficit in [0, 5] K; got {deficit_k!r}")
     residual = foam_radiance(view_zenith, band, sea_radiance, sky, refractive_index=refractive_index)
-    active = foam_radiance(view_zenith, band, skin_disrupted_radiance(sea_radiance, band, deficit_k), sky,
-                           refractive_index=refractive_index)
+    bulk = skin_disrupted_radiance(sea_radiance, band, deficit_k) if bulk_radiance is None else bulk_radiance
+    active = foam_radiance(view_zenith, band, bulk, sky, refractive_index=refractive_index)
     return active.to(residual.dtype), residual
 
 

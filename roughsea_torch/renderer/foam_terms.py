@@ -23,7 +23,8 @@ import torch
 from .._validation import per_batch
 from ..foam import foam_sky_weights
 from ..sky import select_sky
-from ..whitecaps import SCENE_INVERSE_WAVE_AGE, SKIN_DEFICIT_K, active_share, foam_state_radiances
+from ..whitecaps import (SCENE_INVERSE_WAVE_AGE, SKIN_DEFICIT_K, active_share, foam_state_radiances,
+                         skin_disrupted_radiance)
 from .scene import SceneParameters, SeaScene
 from .sky_terms import day_sky
 
@@ -48,9 +49,12 @@ def foam_state_radiances_of_images(theta: torch.Tensor, p: SceneParameters, idx:
     extra = (None,) * (theta.ndim - 1) if not isinstance(idx, torch.Tensor) else ()
     if e_sky.ndim:
         e_sky = e_sky[(...,) + extra]
+    # R_B(T + ΔT_skin) image by image (the transcendental functions' vectorized and scalar paths round
+    # differently, and image i of a batch must be bitwise the image rendered alone), then per element
+    bulk = torch.cat([skin_disrupted_radiance(p.rb[i:i + 1], scene.band, SKIN_DEFICIT_K) for i in range(p.rb.shape[0])])
     act, res = foam_state_radiances(theta, scene.band, p.rb[idx][(...,) + extra].to(dtype), e_sky,
                                     refractive_index=(p.n[idx][(...,) + extra], p.k[idx][(...,) + extra]),
-                                    deficit_k=SKIN_DEFICIT_K)
+                                    deficit_k=SKIN_DEFICIT_K, bulk_radiance=bulk[idx][(...,) + extra].to(dtype))
     return act.to(dtype), res.to(dtype)
 
 
