@@ -4,9 +4,13 @@ Writes ``storm_clip.png`` to ``--out``: one row per wind, one column per frame (
 brightness temperature of one realization (``SeaScene(seed=...)``, whitecaps on by default: active
 on the crests; with ``TableSize(foam_trails=True)``, as here, residual foam decaying over ~2 s and
 drifting downwind, ``roughsea_torch.whitecaps``),
-a camera 15 m above the sea looking 8° down (ranges 60 m to the horizon), midlatitude-summer sky and path;
+a camera 15 m above the sea looking 12° down (rows from about 40 m to 210 m: near range, where a pixel's footprint,
+decimetres, resolves the foam's streaks, ``roughsea_torch.foam_streaks``), midlatitude-summer sky and path;
 one colour range per row (0.5–99.5 % of its frames' sea pixels). A last column shows the foam alone
-at the last frame (foam minus the same frame rendered with ``foam=False``).
+at the last frame (foam minus the same frame rendered with ``foam=False``), and a last one its foam
+cover per pixel (active red, residual cyan, square-root scaled; the per-pixel method's cover, without
+the column filter): the foam's structure, which the temperatures show only faintly at near range,
+where foam and water differ by under 1 K (``docs/foam_table.md``).
 
 Usage:
     python examples/storm_clip.py [--out docs] [--height 128] [--width 160]
@@ -24,6 +28,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import torch  # noqa: E402
 
 import roughsea_torch as rs  # noqa: E402
+from roughsea_torch.clutter import footprint  # noqa: E402
+from roughsea_torch.foam import whitecap_fraction  # noqa: E402
+from roughsea_torch.whitecaps import whitecap_cover  # noqa: E402
 
 TRAILS = rs.TableSize(foam_trails=True)  # the residual foam of the last seconds (default: the breaking now)
 
@@ -31,17 +38,37 @@ TIMES = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0)
 WINDS = (15.0, 20.0, 25.0)
 
 
+def cover(cams, wind: float, t: float) -> tuple[torch.Tensor, torch.Tensor]:
+    """The active and residual foam cover (whitecaps.whitecap_cover, with the trails) of each pixel's
+    flat-sea point and footprint, the per-pixel method's (renderer.direct) without its column filter."""
+    scene = rs.SeaScene(wind_speed=wind, sea_temperature=290.0, seed=11, time_s=t)
+    geom = rs.view_geometry(cams)
+    sea = geom.is_sea
+    wf = scene.wave_field(1, torch.float64, torch.device("cpu"))
+    centres = -(cams.rotation_matrix.transpose(-1, -2) @ cams.translation_vector)[..., 0].double()
+    cos_t = geom.cos_view_zenith.double().clamp_min(1e-9)
+    R = torch.where(sea, geom.range_m.double(), torch.ones_like(cos_t))
+    L = footprint(R, cos_t, (1.0 / cams.fx.double())[:, None, None])
+    x, y = centres[:, 0, None, None] + R * geom.dx.double(), centres[:, 1, None, None] + R * geom.dy.double()
+    time = torch.tensor([t], dtype=torch.float64)
+    c = wf.sample(x, y, time, footprint=L, elevation=False, crest=True)["crest"]
+    w = whitecap_fraction(torch.tensor([wind], dtype=torch.float64))[:, None, None]
+    fa, fr = whitecap_cover(wf, x, y, time, L, c, wf.crest_variance(L), wf.crest_variance()[:, None, None], w)
+    zero = torch.zeros_like(fa)
+    return torch.where(sea, fa, zero)[0], torch.where(sea, fr, zero)[0]
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "examples")
-    ap.add_argument("--height", type=int, default=128)
-    ap.add_argument("--width", type=int, default=160)
+    ap.add_argument("--height", type=int, default=192)
+    ap.add_argument("--width", type=int, default=240)
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     torch.set_num_threads(1)
-    cams = rs.make_camera(args.height, args.width, hfov_deg=20.0, altitude_m=15.0, pitch_deg=-8.0, batch_size=1)
+    cams = rs.make_camera(args.height, args.width, hfov_deg=20.0, altitude_m=15.0, pitch_deg=-12.0, batch_size=1)
     sea = rs.view_geometry(cams).is_sea[0]
-    fig, axes = plt.subplots(len(WINDS), len(TIMES) + 1, figsize=(2.6 * (len(TIMES) + 1), 2.4 * len(WINDS)),
+    fig, axes = plt.subplots(len(WINDS), len(TIMES) + 2, figsize=(2.6 * (len(TIMES) + 2), 2.4 * len(WINDS)),
                              constrained_layout=True)
     for r, wind in enumerate(WINDS):
         frames = [rs.render(cams, rs.SeaScene(wind_speed=wind, sea_temperature=290.0, seed=11, time_s=t),
@@ -56,11 +83,16 @@ def main() -> None:
             axes[r, c].axis("off")
         fig.colorbar(im, ax=axes[r, len(TIMES) - 1], fraction=0.046, label="K")
         d = (frames[-1] - bare).numpy()
-        im = axes[r, -1].imshow(d, cmap="RdBu_r", vmin=-3.0, vmax=3.0)
-        axes[r, -1].set_title(f"foam − no foam, t = {TIMES[-1]:g} s", fontsize=8)
+        im = axes[r, -2].imshow(d, cmap="RdBu_r", vmin=-3.0, vmax=3.0)
+        axes[r, -2].set_title(f"foam − no foam, t = {TIMES[-1]:g} s", fontsize=8)
+        axes[r, -2].axis("off")
+        fig.colorbar(im, ax=axes[r, -2], fraction=0.046, label="K")
+        fa, fr = cover(cams, wind, TIMES[-1])  # red: active (bright), cyan: residual (dark), per pixel
+        rgb = torch.stack([fa, fr, fr], -1).clamp(0, 1) ** 0.5
+        axes[r, -1].imshow(rgb.numpy())
+        axes[r, -1].set_title(f"cover: active (red), residual (cyan), t = {TIMES[-1]:g} s", fontsize=7)
         axes[r, -1].axis("off")
-        fig.colorbar(im, ax=axes[r, -1], fraction=0.046, label="K")
-    fig.suptitle("LWIR storm clip, 15 m mast, 8° down: whitecaps on crests, residual foam fading (τ 2 s) and drifting",
+    fig.suptitle("LWIR storm clip, 15 m mast, 12° down: whitecaps on crests, residual foam fading (τ 2 s) and drifting",
                  fontsize=9)
     fig.savefig(args.out / "storm_clip.png", dpi=110)
     print(f"wrote {args.out / 'storm_clip.png'}")

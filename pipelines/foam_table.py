@@ -5,7 +5,8 @@ At the surface (no path), sea 290 K, under the shipped LOWTRAN midlatitude-summe
 the rough sea's apparent radiance (Eq. 10, anisotropic Cox–Munk slopes, looking upwind, with
 shadowing) against a patch all foam (roughsea_torch.foam: ε_f R_B + (1 − ε_f) S), both as brightness
 temperatures. Beside them, the numbers the foam rests on (ε_f − ε_w against Niclòs et al. 2007 and
-Branch et al. 2016) and the same rows of the previous model (Niclòs's excess continued linearly to
+Branch et al. 2016), the active (bulk temperature, the skin disrupted) and residual states'
+rows, and the same rows of the previous model (Niclòs's excess continued linearly to
 0.08 at 85°, Lambertian reflection of E_sky/π), and of the two changes apart; and the sky that a
 surface of Fresnel facets with bubble-cap slopes reflects (Eq. 10 itself), beside the foam's S.
 
@@ -28,6 +29,7 @@ from roughsea_torch import foam  # noqa: E402
 from roughsea_torch.atmosphere import load_sky  # noqa: E402
 from roughsea_torch.optics import fresnel_emissivity  # noqa: E402
 from roughsea_torch.radiometry import LWIR, MWIR, band_radiance, brightness_temperature  # noqa: E402
+from roughsea_torch.whitecaps import SKIN_DEFICIT_K  # noqa: E402
 
 from _report import write_report  # noqa: E402
 
@@ -86,6 +88,16 @@ def band_rows(name: str, band, m: complex) -> tuple[list[str], dict]:
             key[(u, a)] = (float(new[j] - w), float(old[j] - w))
         lines.append(f"| {a:g} | {float(eps_w[j]):.3f} | {float(eps_new[j] - eps_w[j]):.3f} | "
                      f"{float(eps_old[j] - eps_w[j]):.3f} | {measured.get(a, '')} | " + " | ".join(cells) + " |")
+    # the two states (roughsea_torch.whitecaps.foam_state_radiances): active foam at the bulk temperature
+    rb_bulk = band_radiance(torch.tensor(SEA_K + SKIN_DEFICIT_K, dtype=D), band)
+    active = bt(eps_new * rb_bulk + (1 - eps_new) * s_new)
+    lines += ["", f"Active whitecaps (bulk temperature {SEA_K + SKIN_DEFICIT_K:g} K, the skin deficit of {SKIN_DEFICIT_K:g} K "
+              "disrupted) and residual foam (the skin's {SEA_K:g} K), minus water [K]:".replace("{SEA_K:g}", f"{SEA_K:g}"), "",
+              "| θ̂ [°] | ε_f | active − residual | " + " | ".join(f"{u:g} m/s: active; residual" for u in WINDS) + " |",
+              "|---|---|---|" + "---|" * len(WINDS)]
+    for j, a in enumerate(ANGLES):
+        lines.append(f"| {a:g} | {float(eps_new[j]):.3f} | {float(active[j] - new[j]):+.2f} | " + " | ".join(
+            f"{float(active[j] - water[u][j]):+.1f}; {float(new[j] - water[u][j]):+.1f}" for u in WINDS) + " |")
     lines += ["", "Foam alone [K]: " + ", ".join(f"{a:g}°: {float(new[j]):.1f} (old {float(old[j]):.1f})"
                                                   for j, a in enumerate(ANGLES)), ""]
     facets = {v: bt(facet_sky(sky, band, m, th, v)) for v in (0.3, 1.0)}
@@ -114,8 +126,16 @@ READING = """## Reading
   MWIR within −2 K to 88°. The rough water's own emissivity near grazing is far above flat water's
   (its facets tilt towards the camera), while foam sits in the mean plane here: foam on the same
   tilted facets would read warmer still (not modelled). Darker residual foam is what airborne
-  infrared imagery shows (Marmorino & Smith 2005); their bright, actively breaking whitecaps come
-  from emissivity and a warmer, disrupted skin, which this table does not include.
+  infrared imagery shows (Marmorino & Smith 2005).
+- **Active and residual.** Marmorino & Smith (2005, airborne infrared) see actively breaking
+  whitecaps bright and residual ones dark against the water, and attribute it to "changes in both
+  emissivity and physical temperature" (their abstract; no numbers were reachable). The model keeps
+  the part with a published size: breaking mixes away the cool skin, a few tenths of a kelvin below
+  the bulk (Jessup, Zappa & Yeh 1997), so active foam radiates at T + 0.2 K and residual foam (its
+  skin recovered within seconds) at T. Both keep the measured ε_f: no measurement of thick active
+  against thin residual foam emissivity was found, so none is assumed. Active minus residual is then
+  ε_f (B(T + 0.2 K) − B(T)): about +0.2 K at 60° and less towards grazing in radiance, and active foam
+  is brighter than the water up to about 75° in both bands and darker beyond (the reflected sky dominates).
 - The 0.23 is a spectral maximum: the [Δ only] column and the old model's column bracket what a
   smaller band-averaged excess would give.
 """

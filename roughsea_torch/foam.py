@@ -96,7 +96,8 @@ f_pix = W where the footprint resolves no wave; the pixel is then (1 − f_pix) 
 Left out: foam is a patch of the mean plane (its slopes are not those of the waves: near grazing
 foam on facets tilted towards the camera would be seen at a smaller local incidence and read warmer),
 no shadowing of foam, no foam on the sky-reflection weights of Eq. 10, no multiple reflection
-between foam and water, no foam temperature different from the sea's, no spray.
+between foam and water, no spray; a foam temperature different from the sea's only for active
+whitecaps (the disrupted skin, :mod:`roughsea_torch.whitecaps`).
 """
 
 from __future__ import annotations

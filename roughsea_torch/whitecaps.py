@@ -44,10 +44,46 @@ the crests break now (no trails: the trails' 13 extra reads of the wave field pe
 textured render about 4× slower for foam on under 0.1 % of the sea), blending smoothly in W to the
 trails at :data:`TRAILS_FULL` (about 7 m/s); E[f] = W holds throughout.
 
-Left out: the active state is radiometrically the residual's here (the renderer gives both the
-foam radiance of :mod:`roughsea_torch.foam`); the warmer disrupted skin of active breaking (the cool
-skin is typically ~0.2 K, up to 0.5 K, below the bulk; Jessup, Zappa & Yeh 1997) and the tilt of
-the foam on the breaking face are not modelled. R's deposits are discrete epochs Δ apart: at near
+Structure inside the patches (:mod:`~roughsea_torch.foam_streaks`)
+-----------------------------------------------------------------
+Every indicator above thresholds X + s ν instead of X: ν the foam's streak field (an independent,
+exactly N(0, 1) lattice field of a few metres, elongated along the wind from about 14 m/s, read in the
+drifting surface frame), s² = κ σ_X², κ = :data:`STREAK_VARIANCE_SHARE` = 0.5. A footprint L keeps the
+share r(L) of ν's variance (1 for a point, 0 from two lattice cells across); the resolved variance
+given to the threshold is σ_r² + r s² and the total σ_X² + s², the variances of the sum, so E[B] = W
+stays exact. At near range (decimetre footprints) the patches get soft, streaky edges and holes; at
+far range ν is averaged away and only widens the soft edge (its unresolved variance). κ = 0.5
+(ν's amplitude 0.7 of the crest variable's) is a choice: large enough that the patches break into
+streaks, small enough that foam stays on the crests (the share of a textured storm's foam change
+carried by its most-changed tenth of pixels falls from 0.55 to 0.46, against 0.29 for a uniform veil).
+
+Radiance of the two states (:func:`foam_state_radiances`)
+--------------------------------------------------------
+    R_res = ε_f R_B(T) + (1 − ε_f) S,      R_act = ε_f R_B(T + ΔT_skin) + (1 − ε_f) S,
+
+so R_act − R_res = ε_f (R_B(T + ΔT_skin) − R_B(T)) > 0: active whitecaps are brighter than residual
+foam at every view angle. T is the scene's sea temperature, the radiating SKIN's; active breaking
+mixes the cool skin away and the foam radiates at the bulk temperature T + ΔT_skin, ΔT_skin =
+:data:`SKIN_DEFICIT_K` = 0.2 K: the skin is "a few tenths of a degree" cooler than the water below
+(Jessup, Zappa & Yeh 1997, J. Geophys. Res. 102, C10, 23145–23153, and Nature 385, 52–55: breaking
+disrupts it, infrared imagery sees the warm wake recover over seconds), typically about 0.2 K and
+up to 0.5 K under strong cooling. Both states get the measured foam emissivity ε_f and the reflected
+sky S of :mod:`roughsea_torch.foam`: Marmorino & Smith (2005, Geophys. Res. Lett. 32, L11604) report
+bright active and dark residual whitecaps in airborne infrared imagery and attribute the difference to
+"changes in both emissivity and physical temperature", but the abstract (all that was reachable)
+gives no number for either; no measurement of the emissivity of thick active foam against thin
+residual foam was found, so no emissivity difference is assumed (the only part modelled is the skin
+one, whose size is published). The residual's skin is taken as recovered (T): Jessup et al. see it
+recover within seconds, the residual's decay time τ_R.
+
+The ensemble mean: a pixel's foam term a B R_act + (1 − a) R R_res has mean W (a R_act + (1 − a) R_res)
+(the cover is independent of the slope texture, :func:`~roughsea_torch.foam.crest_foam_fraction`), so
+the expectation image mixes the foam radiance R̄ = a R_act + (1 − a) R_res with the fraction W
+(``renderer/foam_terms.py``) and the textured storms' ensemble mean stays the expectation's.
+
+Left out: an emissivity difference between active and residual foam, the evaporative cooling of
+residual foam, the skin's gradual recovery within the residual, and the tilt of the foam on the
+breaking face. R's deposits are discrete epochs Δ apart: at near
 range a fast crest's trail shows as stamps Δ c apart, softened by the footprint's unresolved part.
 """
 
@@ -58,7 +94,9 @@ from typing import Any
 
 import torch
 
-from .foam import crest_fraction_from_variances
+from .foam import crest_fraction_from_variances, foam_radiance
+from .foam_streaks import resolved_amplitude, streak_lengths, streak_noise
+from .radiometry import band_radiance, brightness_temperature
 from .spectrum import GRAVITY
 
 __all__ = [
@@ -69,7 +107,12 @@ __all__ = [
     "DEPOSIT_WINDOW",
     "TRAILS_FROM",
     "TRAILS_FULL",
+    "SKIN_DEFICIT_K",
+    "STREAK_VARIANCE_SHARE",
+    "SCENE_INVERSE_WAVE_AGE",
     "active_share",
+    "skin_disrupted_radiance",
+    "foam_state_radiances",
     "deposit_epochs",
     "foam_drift",
     "whitecap_cover",
@@ -86,6 +129,9 @@ DEPOSIT_WINDOW = 3.0  # deposits kept within this many τ_R before t (the rest, 
 # cover stays continuous and differentiable in the wind, and E[f] = W throughout).
 TRAILS_FROM = 1e-3  # W, about 5 m/s (Monahan & O'Muircheartaigh 1980)
 TRAILS_FULL = 3e-3  # W, about 7 m/s
+STREAK_VARIANCE_SHARE = 0.5  # κ: var(s ν) / σ_X², the streak field's share beside the crest variable
+SKIN_DEFICIT_K = 0.2  # [K] bulk − skin temperature, disrupted by active breaking (Jessup, Zappa & Yeh 1997)
+SCENE_INVERSE_WAVE_AGE = 0.84  # Ω_c of a SeaScene's wave fields (fully developed, WaveField's default)
 
 
 def active_share(wind_speed: torch.Tensor, inverse_wave_age: torch.Tensor,
@@ -101,6 +147,42 @@ def active_share(wind_speed: torch.Tensor, inverse_wave_age: torch.Tensor,
     """
     tau_a = ACTIVE_PERIOD_SHARE * 2.0 * math.pi * wind_speed / (GRAVITY * inverse_wave_age)
     return tau_a / (tau_a + decay_s)
+
+
+def skin_disrupted_radiance(sea_radiance: torch.Tensor, band: Any, deficit_k: float = SKIN_DEFICIT_K) -> torch.Tensor:
+    """R_B(T + ΔT_skin) [W m⁻² sr⁻¹]: the blackbody band radiance of the bulk water that active breaking
+    brings to the surface, T the brightness temperature of ``sea_radiance`` (the skin's R_B(T)) in
+    ``band``, ΔT_skin = ``deficit_k`` [K] (module docstring). Shape, dtype and device of ``sea_radiance``;
+    differentiable."""
+    if deficit_k == 0:  # the skin's own radiance, exactly (no round trip through the temperature)
+        return sea_radiance
+    t = brightness_temperature(sea_radiance.clamp_min(1e-30), band)
+    return band_radiance(t + deficit_k, band).to(sea_radiance.dtype)
+
+
+def foam_state_radiances(view_zenith: torch.Tensor, band: Any, sea_radiance: torch.Tensor, sky: torch.Tensor,
+                         refractive_index: Any = None, deficit_k: float = SKIN_DEFICIT_K,
+                         bulk_radiance: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+    """(R_act, R_res) [W m⁻² sr⁻¹]: active foam ε_f R_B(T + ΔT_skin) + (1 − ε_f) S and residual foam
+    ε_f R_B(T) + (1 − ε_f) S (module docstring; ε_f, S: :func:`~roughsea_torch.foam.foam_radiance`).
+
+    Args:
+        view_zenith: θ̂ [rad] in [0, π/2]; band: the sensor band (MWIR or LWIR).
+        sea_radiance: R_B(T) of the skin [W m⁻² sr⁻¹] > 0; sky: S, the sky the foam reflects, ≥ 0.
+        refractive_index: the water's (see :func:`~roughsea_torch.foam.foam_emissivity`).
+        deficit_k: ΔT_skin [K] ≥ 0.
+        bulk_radiance: R_B(T + ΔT_skin) if already computed (:func:`skin_disrupted_radiance`), else None.
+    All broadcast together; float32/float64 and device follow the inputs.
+
+    Returns:
+        R_act, R_res of the broadcast shape; R_act ≥ R_res (equal for ``deficit_k`` = 0).
+    """
+    if not (isinstance(deficit_k, (int, float)) and math.isfinite(deficit_k) and 0.0 <= deficit_k <= 5.0):
+        raise ValueError(f"deficit_k must be a skin temperature deficit in [0, 5] K; got {deficit_k!r}")
+    residual = foam_radiance(view_zenith, band, sea_radiance, sky, refractive_index=refractive_index)
+    bulk = skin_disrupted_radiance(sea_radiance, band, deficit_k) if bulk_radiance is None else bulk_radiance
+    active = foam_radiance(view_zenith, band, bulk, sky, refractive_index=refractive_index)
+    return active.to(residual.dtype), residual
 
 
 def foam_drift(wind_speed: torch.Tensor, wind_direction: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
@@ -141,7 +223,9 @@ def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tens
                    crest_now: torch.Tensor, resolved_variance: torch.Tensor, total_variance: torch.Tensor,
                    whitecap_fraction: torch.Tensor, decay_s: float = RESIDUAL_DECAY_S,
                    trails: bool = True) -> tuple[torch.Tensor, torch.Tensor]:
-    """The active and residual foam cover (a B, (1 − a) R) of points of a wave field (module docstring).
+    """The active and residual foam cover (a B, (1 − a) R) of points of a wave field (module docstring),
+    each indicator thresholding the crest variable plus the drifting streak field
+    (:mod:`~roughsea_torch.foam_streaks`, resolved as the footprint allows).
 
     Args:
         wf: the :class:`~roughsea_torch.waves.WaveField` (B images).
@@ -165,8 +249,22 @@ def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tens
     vx, vy = (v.to(dtype)[(...,) + extra] for v in foam_drift(wf.wind_speed, wf.wind_direction))
     epochs, weights = deposit_epochs(time_s, decay_s)
 
+    # the fine structure: X + s ν, ν the drifting streak field (foam_streaks), s² = κ σ_X², of which the
+    # footprint keeps the share r; the variances given to the threshold are the sum's, so E[B] = W stays exact
+    v_norm = torch.sqrt(vx * vx + vy * vy).clamp_min(1e-30)
+    along, across = streak_lengths(wf.wind_speed)
+    t_now = time_s[(...,) + extra]  # the drifting frame in float64 (times and positions may be large)
+    root_r = resolved_amplitude(footprint, across.to(dtype)[(...,) + extra])  # √r, r the share the footprint keeps
+    keep = None if footprint is None else (root_r.detach() > 0).expand(x.shape)
+    nu = streak_noise(x.double() - vx.double() * t_now, y.double() - vy.double() * t_now, wf.seeds,
+                      (vx / v_norm).reshape(-1), (vy / v_norm).reshape(-1), along, across, where=keep).to(dtype)
+    s2 = STREAK_VARIANCE_SHARE * total_variance
+    lift = root_r * torch.sqrt(s2.clamp_min(1e-30)) * nu
+    r = root_r * root_r
+    v_res, v_tot = resolved_variance + r * s2, total_variance + s2
+
     def indicator(crest: torch.Tensor) -> torch.Tensor:
-        return crest_fraction_from_variances(crest, resolved_variance, total_variance, whitecap_fraction)
+        return crest_fraction_from_variances(crest + lift, v_res, v_tot, whitecap_fraction)
 
     now = indicator(crest_now)
     t = ((whitecap_fraction - TRAILS_FROM) / (TRAILS_FULL - TRAILS_FROM)).clamp(0.0, 1.0)

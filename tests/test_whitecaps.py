@@ -13,6 +13,7 @@ import roughsea_torch as rs
 from roughsea_torch.foam import crest_foam_fraction, whitecap_fraction
 from roughsea_torch.waves import WaveField
 from roughsea_torch.whitecaps import (DEPOSIT_INTERVAL_S, RESIDUAL_DECAY_S, TRAILS_FROM, TRAILS_FULL, active_share,
+                                     foam_state_radiances,
                                      deposit_epochs, whitecap_cover)
 
 from conftest import make_cams
@@ -93,19 +94,28 @@ def test_rare_whitecaps_leave_no_trails_and_the_blend_is_continuous(storm):
     a = active_share(wf.wind_speed, wf.inverse_wave_age)[:, None]
     lo = 0.5 * TRAILS_FROM
     fa, fr, c = _cover(wf, x, y, 3.3, fp, lo)
-    b = crest_foam_fraction(c, wf.crest_variance(fp), wf.crest_variance()[:, None], lo)
+    b = crest_foam_fraction(c, wf.crest_variance(fp), _vt(wf), lo)
     torch.testing.assert_close(fa, a * b, rtol=1e-12, atol=1e-15)
     torch.testing.assert_close(fr, (1 - a) * b, rtol=1e-12, atol=1e-15)
     hi, mid = TRAILS_FULL, 0.5 * (TRAILS_FROM + TRAILS_FULL)
     _, fr_hi, _ = _cover(wf, x, y, 3.3, fp, hi)
-    b_hi = crest_foam_fraction(c, wf.crest_variance(fp), wf.crest_variance()[:, None], hi)
+    b_hi = crest_foam_fraction(c, wf.crest_variance(fp), _vt(wf), hi)
     assert float((fr_hi - (1 - a) * b_hi).abs().max()) > 0.05  # the trails differ from the breaking now
     _, fr_mid, _ = _cover(wf, x, y, 3.3, fp, mid)
-    b_mid = crest_foam_fraction(c, wf.crest_variance(fp), wf.crest_variance()[:, None], mid)
+    b_mid = crest_foam_fraction(c, wf.crest_variance(fp), _vt(wf), mid)
     assert float(fr_mid.sum()) > 0 and bool(torch.isfinite(fr_mid).all())
     # halfway the residual is the smoothstep (here 1/2) blend of the breaking now and the trails at that W
     with_trails = _residual_with_trails(wf, x, y, 3.3, fp, mid)
     torch.testing.assert_close(fr_mid, (1 - a) * 0.5 * (b_mid + with_trails), rtol=1e-10, atol=1e-14)
+
+
+def _vt(wf):
+    """σ_X² + s²: the threshold's total variance with the streak field (whitecaps: κ σ_X² more); at the 2 m
+    footprints of these tests the streaks are averaged away (foam_streaks.resolved_share = 0 from two
+    0.57 m cells across at 15 m/s), so only this variance, not ν itself, enters."""
+    from roughsea_torch.whitecaps import STREAK_VARIANCE_SHARE
+
+    return (1.0 + STREAK_VARIANCE_SHARE) * wf.crest_variance()[:, None]
 
 
 def _residual_with_trails(wf, x, y, t, fp, w):
@@ -119,7 +129,7 @@ def _residual_with_trails(wf, x, y, t, fp, w):
     for j in range(epochs.shape[1]):
         age = (t - epochs[:, j])[:, None]
         c = wf.sample_unchecked(x - vx * age, y - vy * age, epochs[:, j], fp, False, True)["crest"]
-        r = r + weights[:, j][:, None] * crest_foam_fraction(c, wf.crest_variance(fp), wf.crest_variance()[:, None], w)
+        r = r + weights[:, j][:, None] * crest_foam_fraction(c, wf.crest_variance(fp), _vt(wf), w)
     return r
 
 
@@ -139,3 +149,57 @@ def test_textured_storm_ensemble_mean_is_the_expectation_with_foam():
     ref = (mean * sea).sum((0, 1, 3)) / sea.sum((0, 1, 3)).clamp_min(1)
     keep = sea.sum((0, 1, 3)) > 0
     assert float(((rows - ref).abs() / ref)[keep].max()) < 1e-2
+
+
+@pytest.mark.parametrize("band", [rs.LWIR, rs.MWIR])
+@pytest.mark.parametrize("dtype,tol", [(torch.float64, 1e-7), (torch.float32, 2e-4)])
+def test_active_foam_is_brighter_than_residual_by_the_skin_deficit(band, dtype, tol):
+    """Active whitecaps radiate at the bulk temperature (the cool skin mixed away, 0.2 K warmer), residual
+    foam at the skin's: R_act − R_res = ε_f (B(T + 0.2 K) − B(T)) > 0 at every view angle, against the
+    numpy reference (its own Fresnel, Planck band integral and emissivity excess); in brightness
+    temperature the gap is ε_f × 0.2 K up to 40° (0.19 K at nadir LWIR, where ε_f = 0.99; near grazing
+    the foam is colder, the Planck slope there smaller, and the same radiance gap reads larger in kelvin). Fails with the active state radiometrically the residual's (planted: R_act = R_res)."""
+    from roughsea_torch.reference import foam as ref
+
+    theta = torch.linspace(0.0, math.radians(89.0), 24, dtype=dtype)
+    sky = 20.0 if band == rs.LWIR else 0.3
+    rb = rs.band_radiance(torch.tensor(290.0, dtype=dtype), band)
+    act, res = foam_state_radiances(theta, band, rb, torch.tensor(sky, dtype=dtype))
+    lo_hi = tuple(band)
+    want_act, want_res = ref.foam_state_radiances(theta.double().numpy(), lo_hi, 290.0, sky)
+    torch.testing.assert_close(act.double(), torch.tensor(want_act), rtol=tol, atol=0)
+    torch.testing.assert_close((act - res).double(), torch.tensor(want_act - want_res), rtol=50 * tol, atol=0)
+    assert bool((act > res).all())
+    gap = rs.brightness_temperature(act.double(), band) - rs.brightness_temperature(res.double(), band)
+    eps = torch.tensor(ref.foam_emissivity(theta.double().numpy(), lo_hi))
+    near = theta <= math.radians(40.0)  # where the foam's brightness temperature is near T (Planck slope alike)
+    torch.testing.assert_close(gap[near], 0.2 * eps[near], rtol=0.05, atol=0)
+
+
+def test_foam_state_gradients_are_finite():
+    """d/dT_sea and d/dU of a textured storm's foam radiance mean, float32 and float64, at a grazing view."""
+    for dtype in (torch.float32, torch.float64):
+        t = torch.tensor(290.0, dtype=dtype, requires_grad=True)
+        theta = torch.tensor([0.3, 1.4, 1.5690], dtype=dtype)
+        act, res = foam_state_radiances(theta, rs.LWIR, rs.band_radiance(t, rs.LWIR), torch.tensor(20.0, dtype=dtype))
+        u = torch.tensor([15.0], dtype=torch.float64, requires_grad=True)
+        a = active_share(u, torch.tensor([0.84], dtype=torch.float64)).to(dtype)
+        (res + a * (act - res)).sum().backward()
+        assert torch.isfinite(t.grad) and torch.isfinite(u.grad).all() and float(t.grad) > 0
+
+
+def test_textured_ensemble_mean_weights_the_two_states_as_the_expectation(monkeypatch):
+    """With an exaggerated skin deficit (4 K, so that the states differ by ~4 % of the radiance), the
+    mean over 12 realizations of a 20 m/s storm's sea pixels (default covers, no trails) equals the
+    expectation image's, whose foam is a R_act + (1 − a) R_res, within 1e-3 (measured 4.3e-5; the
+    sampling error of the test above); an expectation with the residual's radiance alone is 4e-3 off
+    (planted: a = 0 in renderer.foam_terms.active_share_of_images fails)."""
+    from roughsea_torch.renderer import foam_terms
+
+    monkeypatch.setattr(foam_terms, "SKIN_DEFICIT_K", 4.0)
+    cams = make_cams(16, 24, pitch_deg=-8.0, batch_size=12, hfov_deg=20.0, altitude_m=15.0)
+    kw = dict(wind_speed=20.0, sea_temperature=290.0, path=False)
+    tex = rs.render(cams, rs.SeaScene(**kw, seed=list(range(40, 52)), time_s=0.7))
+    mean = rs.render(cams, rs.SeaScene(**kw))
+    sea = rs.view_geometry(cams).is_sea[:, None]
+    assert abs(float(((tex - mean) * sea).sum() / (mean * sea).sum())) < 1e-3

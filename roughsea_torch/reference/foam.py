@@ -15,6 +15,9 @@ independent of it:
   rho_f = 1 - eps_f (mu = cos of the incidence zenith); "lambertian" S = E_sky/pi =
   2 int_0^1 R_s(mu) mu dmu. Adaptive quadrature, split at the kinks of delta.
 - Mixture: (1 - f) R_a + f R_foam.
+- Active and residual foam: the active state radiates at the bulk temperature T + 0.2 K (the cool skin
+  disrupted; Jessup, Zappa & Yeh 1997), the residual at the skin's T; the expectation mixes
+  a R_act + (1 - a) R_res.
 """
 
 import math
@@ -24,9 +27,10 @@ import numpy as np
 from scipy import integrate
 
 from .fresnel import fresnel_reflectance
+from .planck import band_radiance
 
 __all__ = ["whitecap_fraction", "foam_emissivity", "foam_radiance", "sky_hemispherical_mean", "foam_sky_radiance",
-           "with_foam"]
+           "with_foam", "foam_state_radiances", "foam_mean_radiance"]
 
 A_MONAHAN = 3.84e-6
 B_MONAHAN = 3.41
@@ -118,3 +122,22 @@ def with_foam(apparent_radiance, foam_fraction, foam_radiance):
     f = _check("foam_fraction", foam_fraction, 0.0, 1.0)
     rf = _check("foam_radiance", foam_radiance, 0.0, np.inf)
     return (1.0 - f) * ra + f * rf
+
+
+SKIN_DEFICIT_K = 0.2  # bulk minus skin temperature [K], Jessup, Zappa & Yeh 1997 ("a few tenths of a degree")
+
+
+def foam_state_radiances(view_zenith, band, sea_temperature, sky_radiance, refractive_index=None,
+                         deficit_k=SKIN_DEFICIT_K):
+    """(active, residual) foam radiance: eps_f B(T + dT) + (1 - eps_f) S and eps_f B(T) + (1 - eps_f) S,
+    T the skin (sea) temperature [K], dT the skin deficit that active breaking mixes away."""
+    eps = foam_emissivity(view_zenith, band, refractive_index)
+    b_skin = band_radiance(sea_temperature, band)
+    b_bulk = band_radiance(sea_temperature + deficit_k, band)
+    return eps * b_bulk + (1.0 - eps) * sky_radiance, eps * b_skin + (1.0 - eps) * sky_radiance
+
+
+def foam_mean_radiance(view_zenith, band, sea_temperature, sky_radiance, active_share, refractive_index=None):
+    """The expectation's foam radiance a R_act + (1 - a) R_res, a the active share of the cover."""
+    act, res = foam_state_radiances(view_zenith, band, sea_temperature, sky_radiance, refractive_index)
+    return active_share * act + (1.0 - active_share) * res

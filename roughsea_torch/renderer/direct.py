@@ -24,7 +24,7 @@ from ..slopes import SlopeStatistics
 from ..sun import glint_radiance, sun_masking_factor
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
-from .foam_terms import foam_mix
+from .foam_terms import foam_mix, foam_mix_states
 from .output import kelvin
 from .path import apply_path, check_path_altitude
 from .scene import SceneParameters, SeaScene
@@ -148,10 +148,9 @@ def sea_textured_direct(geom: ViewGeometry, cameras: PinholeCamera, p: ScenePara
         f_act, f_res = whitecap_cover(wf, xw, yw, time, L, smp["crest"], wf.crest_variance(L),
                                       wf.crest_variance()[:, None, None], p.foam.to(dtype)[:, None, None],
                                       trails=table.foam_trails)
-        f = f_act + f_res
         if table.texture_antialias:
-            f = filter_columns(torch.where(sea, f, torch.zeros_like(f)), sea, FOAM_TAPS)
-        vals = foam_mix(vals, th, p, img_idx, scene, f[sea])
+            f_act, f_res = (filter_columns(torch.where(sea, f, torch.zeros_like(f)), sea, FOAM_TAPS) for f in (f_act, f_res))
+        vals = foam_mix_states(vals, th, p, img_idx, scene, f_act[sea], f_res[sea])
     out = torch.zeros(sea.shape, dtype=vals.dtype, device=vals.device)
     return out.index_put((sea,), vals)
 

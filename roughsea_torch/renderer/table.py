@@ -44,7 +44,7 @@ from ..sky import select_sky
 from ..slopes import SlopeStatistics
 from .coordinates import (ViewSpans, angle_of_ratio, asinh_fast, azimuth_coordinate, azimuth_ratio, camera_spans,
                           geometry_spans, ratio_of_angle)
-from .foam_terms import foam_radiance_of_images
+from .foam_terms import foam_radiance_of_images, foam_state_radiances_of_images
 from .glint import glint_pixels, glint_sharp_pixels, glint_table, glitter_inputs
 from .output import kelvin
 from .path import path_rows
@@ -278,8 +278,8 @@ def fine_table(plan: RenderPlan, nd: NodeValues, sl: slice) -> FineTable:
             r_glint, glint_tab = glint_table(plan.scene, plan.p, sl, plan.eps[sl], nd.lo, nd.span_z, plan.y_z, col_angle, y,
                                              nd.spans.centre, plan.period / 2, sea_cols, scale, plan.table, plan.dtype)
         fine = torch.cat([sea_cols, sky[:, :, None].expand(-1, -1, plan.Lp.shape[0])], 1)
-    if crest:  # channel 1: the foam (sky rows alike), one grid_sample reads both
-        fine = torch.stack([fine, torch.cat([foam_rows, sky], 1)[:, :, None].expand_as(fine)], 1)
+    if crest:  # channels 1 and 2: the active and residual foam (sky rows alike), one grid_sample reads all
+        fine = torch.stack([fine] + [torch.cat([r, sky], 1)[:, :, None].expand_as(fine) for r in foam_rows], 1)
     elif glint_tab is not None and bool(glint_tab.any()):  # channel 1: the glint's smooth factor (0 on sky rows)
         fine = torch.stack([fine, torch.cat([r_glint, torch.zeros_like(fine[:, plan.Mz:])], 1)], 1)
     else:
@@ -291,7 +291,7 @@ def fine_table(plan: RenderPlan, nd: NodeValues, sl: slice) -> FineTable:
 def sea_rows_of(plan: RenderPlan, nd: NodeValues, sl: slice, crest: bool) -> tuple[torch.Tensor, Any, Any]:
     """The sea rows of the images ``sl`` (b, M_z, nphi): τ · R_a + L_path resampled from the ζ nodes,
     with the whitecaps mixed in (unless they sit on the crests); and τ per row (or None), and the
-    foam's radiance per row (b, M_z) (or None)."""
+    foam's radiance per row (b, M_z) (or None; with ``crest`` the active and residual foam's, a pair)."""
     p, scene, dtype, device = plan.p, plan.scene, plan.dtype, plan.device
     b_ = sl.stop - sl.start
     lo, span_z = nd.lo, nd.span_z
@@ -309,9 +309,12 @@ def sea_rows_of(plan: RenderPlan, nd: NodeValues, sl: slice, crest: bool) -> tup
         # whitecaps, an area fraction f: (1 − f) · sea + f · foam, the foam exact on every fine row
         # (its emissivity has kinks in θ̂ that the nodes would smooth), through the same path
         cos_f = (plan.eps[sl, None] * torch.sinh(lo[:, None] + span_z[:, None] * (plan.y_z + 1) / 2)).clamp(0.0, 1.0).to(dtype)
-        foam_rows = foam_radiance_of_images(torch.acos(cos_f), p, sl, scene)
+        theta_f = torch.acos(cos_f)
+        foam_rows = foam_state_radiances_of_images(theta_f, p, sl, scene) if crest else \
+            foam_radiance_of_images(theta_f, p, sl, scene)  # the two states' on crests, their mean otherwise
         if scene.path is not None:
-            foam_rows = tau.to(dtype) * foam_rows + l_path.to(dtype)
+            foam_rows = tuple(tau.to(dtype) * r + l_path.to(dtype) for r in foam_rows) if crest else \
+                tau.to(dtype) * foam_rows + l_path.to(dtype)
         if not crest:
             f = p.foam[sl].to(dtype)[:, None, None]
             sea_rows = sea_rows + f * (foam_rows[:, :, None] - sea_rows)
@@ -483,7 +486,7 @@ def pixel_rays(plan: RenderPlan, maps: TableMaps, sl: slice) -> PixelRays:
 
 def lookup(plan: RenderPlan, ft: FineTable, maps: TableMaps, rays: PixelRays) -> tuple[torch.Tensor, torch.Tensor | None]:
     """The fine table at each pixel by one bilinear ``grid_sample``: channel 0 (b, H, W) and channel 1
-    (the crest foam or the glint's smooth factor) or None.
+    (the glint's smooth factor), channels 1–2 (the crest foam's active and residual states) or None.
 
     Bilinear, not bicubic: torch's bicubic is Keys' kernel with a = −0.75, which converges only to
     first order; bilinear on the fine table is second order (~3e-7 at 3072 rows). The grid is stacked
@@ -498,6 +501,8 @@ def lookup(plan: RenderPlan, ft: FineTable, maps: TableMaps, rays: PixelRays) ->
                          padding_mode="border", align_corners=True)
     if vals.shape[1] == 2:
         return vals[:, 0], vals[:, 1]
+    if vals.shape[1] == 3:  # the crest foam's two states
+        return vals[:, 0], vals[:, 1:]
     return vals[:, 0], None
 
 
@@ -534,11 +539,12 @@ def per_pixel_terms(plan: RenderPlan, ft: FineTable, maps: TableMaps, rays: Pixe
         vals = vals + r_vals * glint_sharp_pixels(scene, p, sl, cos_t, dx, dy, sea & ft.glint_tab[:, None, None])
     if plan.sunny and (ft.glint_tab is None or not bool(ft.glint_tab.all())):  # the rest per pixel
         vals = vals + pixel_glint(plan, ft, rays, cos_t, resolved, sl)
-    if ft.crest:  # (1 − f_pix) · (sea + texture + glint) + f_pix · foam
-        # no foam in the sky: there f_pix would be W, and the lerp would take that share of the
-        # sky pixels from the foam channel's sky rows, which lack the day's scattered sky
+    if ft.crest:  # (sea + texture + glint) + f_act (active − ·) + f_res (residual − ·)
+        # no foam in the sky: there the covers would be a W and (1 − a) W, and the mix would take that
+        # share of the sky pixels from the foam channels' sky rows, which lack the day's scattered sky
         # (added to the sky pixels of channel 0 above)
-        vals = torch.lerp(vals, foam_vals, torch.where(sea, f_pix, torch.zeros_like(f_pix)))
+        f_act, f_res = (torch.where(sea, f, torch.zeros_like(f)) for f in f_pix)
+        vals = vals + f_act * (foam_vals[:, 0] - vals) + f_res * (foam_vals[:, 1] - vals)
     if plan.sunny and ft.has_sky:  # the sun's disk itself, where it is in view
         ifov = (1.0 / plan.cameras.cameras.fx.to(dtype))[sl]
         vals = vals + sun_disk_pixels(scene, plan.B, sl, cos, dx, dy, ~sea, ifov)

@@ -258,7 +258,7 @@ class TextureTable:
                span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any, crest: bool = False) -> tuple:
         """The texture of every pixel of images ``sl`` (0 off the sea), (b, H, W); each pixel's resolved
         quantile x and resolved covariance (world frame), for the glint; and with ``crest`` its foam
-        fraction f_pix (active and residual, :func:`~roughsea_torch.whitecaps.whitecap_cover`, 0 off the sea), else None.
+        covers (f_act, f_res) (:func:`~roughsea_torch.whitecaps.whitecap_cover`, 0 off the sea), else None.
 
         Pixels: cos θ̂ ``cos_t``, ζ ``zeta`` and the azimuth coordinate ``o`` (the angle, over the
         span [a, b]) of their line of sight, the ray's components along the camera's vertical ``dz``
@@ -289,11 +289,11 @@ class TextureTable:
             f_act, f_res = whitecap_cover(wf, X, Y, self.time[sl], L, torch.where(sea, smp["crest"], zero),
                                           torch.where(sea, cov[:, 3], zero), wf.crest_variance()[:, None, None],
                                           self.p.foam[sl].to(dtype)[:, None, None], trails=self.foam_trails)
-            f_pix = torch.where(sea, f_act + f_res, zero)
+            f_pix = (torch.where(sea, f_act, zero), torch.where(sea, f_res, zero))
         out = torch.where(sea, out, torch.zeros_like(out))
         if self.antialias:  # the band at the rows' Nyquist folds into one-pixel lines (renderer.antialias)
             out = filter_columns(out, sea, TEXTURE_TAPS)
-            f_pix = None if f_pix is None else filter_columns(f_pix, sea, FOAM_TAPS)
+            f_pix = None if f_pix is None else tuple(filter_columns(f, sea, FOAM_TAPS) for f in f_pix)
         # x (or, with a sun, the visible quantile x' read from channel 1) and the resolved covariance go
         # back too: the glint of the same realization needs them
         return (out, x if vol.shape[1] == 1 else (x, read[:, 1]),
@@ -306,7 +306,7 @@ class TextureTable:
         and foam fraction at each sample, each pixel's angular average over the visible surface of its
         window; for the glint, x and the covariance at its centre ray's first hit."""
         zero = torch.zeros_like(dz)
-        texture, x_c, f_pix = zero.clone(), zero.clone(), zero.clone() if crest else None
+        texture, x_c, f_pix = zero.clone(), zero.clone(), (zero.clone(), zero.clone()) if crest else None
         cov_c = [zero.clone() for _ in range(3)]
         for i in range(dz.shape[0]):
             s = sea[i]
@@ -325,8 +325,9 @@ class TextureTable:
             tau_t, tau_b = pixel_windows(tan_g, float(self.ifov[im]))
             avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g)
             texture[i] = texture[i].index_put((s,), avg[0])
-            if crest:
-                f_pix[i] = f_pix[i].index_put((s,), avg[1])
+            if crest:  # the active and residual covers
+                for c in range(2):
+                    f_pix[c][i] = f_pix[c][i].index_put((s,), avg[1 + c])
             x_c[i] = x_c[i].index_put((s,), torch.where(hit, x_k[j, k], torch.zeros_like(tan_g)))
             for c in range(3):
                 cov_c[c][i] = cov_c[c][i].index_put((s,), cov_k[c][k])
@@ -368,7 +369,7 @@ class TextureTable:
             var_r = pick(wf.crest_variance(sw.footprint[None]), row)[None]
             f_act, f_res = whitecap_cover(wf, Xv, Yv, t_s, fv, smp["crest"], var_r, wf.crest_variance()[:, None],
                                           self.p.foam[im:im + 1].to(dtype)[:, None], trails=self.foam_trails)
-            values.append((f_act + f_res)[0])
+            values += [f_act[0], f_res[0]]
         # back to every sample (0 at the hidden ones), in the (nt, ns) layout of the envelope
         full = x_v.new_zeros(len(values) + 1, nt * ns).index_copy(1, col * ns + row, torch.stack(values + [x_v]))
         full = full.reshape(-1, nt, ns)

@@ -17,6 +17,7 @@ import roughsea_torch as rs
 import roughsea_torch.reference as ref
 from roughsea_torch.foam import whitecap_fraction
 from roughsea_torch.radiometry import as_band
+from roughsea_torch.renderer import foam_terms
 from roughsea_torch.solar import load_solar_irradiance
 
 from conftest import TIME_RANGE, horizon_sky, make_cams, make_scene, planck_band, smooth_sky
@@ -63,12 +64,13 @@ def test_default_scene_with_named_atmosphere_and_path(dtype):
     assert 0.5 < float(mst.sky(torch.tensor(1.0))) < 1.2  # the MWIR sky, not the LWIR one
 
 
-def test_scene_sea_radiance_is_the_band_radiance_of_its_own_band():
+def test_scene_sea_radiance_is_the_band_radiance_of_its_own_band(monkeypatch):
     """A 290 K sea under a sky of the same band radiance (no path): every pixel, sea or sky, is the
     band radiance of a 290 K blackbody in the scene's band, from Planck integrated here (MWIR
     3–5 µm: 1.28 W m⁻² sr⁻¹; LWIR: 32.5 W m⁻² sr⁻¹; a scene given the other band's sea radiance is off
     by 25×), and its brightness temperature is 290 K. (The LWIR default is exercised by every
     other scene test.)"""
+    monkeypatch.setattr(foam_terms, "SKIN_DEFICIT_K", 0.0)  # active whitecaps at the sea's temperature too
     band = (3e-6, 5e-6)
     L = planck_band(290.0, *band)
     scene = make_scene(wind_speed=torch.tensor(6.0, dtype=F64), band=band, sky=L, path=False)
@@ -81,10 +83,11 @@ def test_scene_sea_radiance_is_the_band_radiance_of_its_own_band():
     np.testing.assert_allclose(bt.numpy(), 290.0, rtol=0, atol=1e-4)
 
 
-def test_scene_response_shapes_the_sea_radiance():
+def test_scene_response_shapes_the_sea_radiance(monkeypatch):
     """A tabulated spectral response (the reference integrates it with scipy): a 295 K sea under a
     sky equal to that response-weighted band radiance renders that radiance everywhere; the flat
     band's would differ by ~30 %."""
+    monkeypatch.setattr(foam_terms, "SKIN_DEFICIT_K", 0.0)  # active whitecaps at the sea's temperature too
     wl = np.array([7.5e-6, 8.5e-6, 10e-6, 11.5e-6, 12.5e-6])
     resp = np.array([0.0, 0.9, 1.0, 0.7, 0.0])
     band = (7.5e-6, 12.5e-6)

@@ -12,6 +12,7 @@ import pytest
 import torch
 
 import roughsea_torch as rs
+from roughsea_torch.renderer import foam_terms
 from roughsea_torch.renderer.antialias import FOAM_TAPS, filter_columns
 from roughsea_torch.clutter import footprint
 from roughsea_torch.renderer.texture import TextureTable
@@ -30,8 +31,10 @@ def _scene(seed, **kw):
     return make_scene(**{"sky": horizon_sky, "path": False, "seed": seed, **kw})
 
 
-def test_second_law_per_realization():
-    """A sky at the sea's blackbody radiance: every pixel of every realization is R_B."""
+def test_second_law_per_realization(monkeypatch):
+    """A sky at the sea's blackbody radiance (and active foam at the skin's temperature, no skin deficit:
+    one temperature everywhere): every pixel of every realization is R_B."""
+    monkeypatch.setattr(foam_terms, "SKIN_DEFICIT_K", 0.0)
     cams = _cams(2, pitch=-10.0)
     rb = 27.5
     img = rs.render(cams, rs.SeaScene(wind_speed=10.0, sea_radiance=rb, sky=rb, path=False, seed=[5, 6], time_s=1.5))
@@ -341,7 +344,7 @@ def test_texture_table_returns_the_pixels_crest(monkeypatch):
         finally:
             self.p.foam = foam
         assert len(result) == 4 and result[3] is not None
-        captured.append(result[3])
+        captured.append(result[3][0] + result[3][1])  # the active and residual covers
         return result[:3] + (None,)
 
     monkeypatch.setattr(TextureTable, "pixels", with_crest)

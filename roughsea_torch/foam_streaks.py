@@ -1,0 +1,114 @@
+"""Fine structure of the foam cover: an anisotropic Gaussian lattice field ν, streaks along the wind.
+
+Whitecaps and the residual foam they leave are not smooth blobs: foam lies in patches, filaments and,
+from about Beaufort 7 (14 m/s), in well-marked streaks along the wind (the WMO Beaufort scale's sea
+state descriptions: "foam ... blown in streaks along the direction of the wind" from force 7;
+"dense streaks" from force 9). The crest variable X of the wave field (whose bands stop near ten
+times the peak wavenumber, tens of metres at storm winds) has none of that. :mod:`~roughsea_torch.whitecaps`
+thresholds X + s ν instead of X, with ν an independent, exactly N(0, 1) field of a few metres:
+
+    ν(x) = Σ_{corners} w_u w_v z_{ij},   w = cos(π f/2) or sin(π f/2) per axis,
+
+z_{ij} i.i.d. N(0, 1) on a lattice of spacing ℓ_along × ℓ_across in the wind's frame (a counter-based
+hash of the image's seed and the node, splitmix64's finalizer, through Φ⁻¹), f the point's fraction
+of its cell. The squares of the four weights sum to 1, so ν is N(0, 1) at every point, whatever f
+(not only on average); it is continuous, and correlated over about one cell. ℓ_along =
+:data:`STREAK_LENGTH_M` = 2 m; ℓ_across = ℓ_along / A(U10), A = 1 + 4 s((U10 − 8)/12) (s the
+smoothstep): isotropic at and below 8 m/s, five times longer than wide (0.4 m) from 20 m/s, the
+Beaufort scale's onset of streaks (force 7–9, 14–24 m/s) taken as the ramp. The lattice is anchored in
+the drifting surface (ν is read at x − v t, v the foam's drift): the structure drifts with the foam
+and does not flicker. The scales and the ramp are this model's choices within the 0.3–3 m that the
+descriptions suggest; no measured spectrum of foam texture was used.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Sequence
+
+import torch
+
+__all__ = ["STREAK_LENGTH_M", "STREAK_ANISOTROPY", "streak_lengths", "streak_noise", "resolved_amplitude", "resolved_share"]
+
+STREAK_LENGTH_M = 2.0  # [m] ℓ_along, the lattice cell along the wind
+STREAK_ANISOTROPY = 5.0  # ℓ_along / ℓ_across from 20 m/s (Beaufort 8–9: dense streaks)
+_RAMP = (8.0, 20.0)  # [m/s] isotropic below, fully anisotropic above (Beaufort 5 to 8–9)
+_M52 = (1 << 52) - 1
+
+
+def streak_lengths(wind_speed: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """(ℓ_along, ℓ_across) [m] at U10 ``wind_speed`` [m/s] (any shape; differentiable)."""
+    t = ((wind_speed - _RAMP[0]) / (_RAMP[1] - _RAMP[0])).clamp(0.0, 1.0)
+    a = 1.0 + (STREAK_ANISOTROPY - 1.0) * t * t * (3.0 - 2.0 * t)
+    return torch.full_like(wind_speed, STREAK_LENGTH_M), STREAK_LENGTH_M / a
+
+
+def resolved_amplitude(footprint: torch.Tensor | None, length_across: torch.Tensor) -> torch.Tensor | float:
+    """√r = (1 − (L / 2ℓ_across)²)₊, r = √r² the share of ν's variance a footprint L [m] keeps: 1 for a
+    point (None), 0 from two cells across (the footprint averages the lattice away: the far field's
+    cover is then exactly the crest variable's, W where nothing is resolved). Only r enters the resolved
+    variance, so the cover's ensemble mean stays exact whatever this approximation of the averaging.
+    (√r is returned rather than r: the square root's gradient at r = 0 would be infinite.)"""
+    if footprint is None:
+        return 1.0
+    q = footprint / (2.0 * length_across)
+    return (1.0 - q * q).clamp_min(0.0)
+
+
+def resolved_share(footprint: torch.Tensor | None, length_across: torch.Tensor) -> torch.Tensor | float:
+    """r = (1 − (L / 2ℓ_across)²)₊² (:func:`resolved_amplitude` squared)."""
+    a = resolved_amplitude(footprint, length_across)
+    return a * a
+
+
+def _mix(x: torch.Tensor) -> torch.Tensor:
+    """splitmix64's finalizer on int64 tensors (wrapping arithmetic; logical shifts by masking)."""
+    def shr(v: torch.Tensor, s: int) -> torch.Tensor:
+        return (v >> s) & ((1 << (64 - s)) - 1)
+    x = x + (-7046029254386353131)  # 0x9E3779B97F4A7C15 as int64
+    x = (x ^ shr(x, 30)) * (-4658895280553007687)  # 0xBF58476D1CE4E5B9
+    x = (x ^ shr(x, 27)) * (-7723592293110705685)  # 0x94D049BB133111EB
+    return x ^ shr(x, 31)
+
+
+def _node_normal(base: torch.Tensor, i: torch.Tensor, j: torch.Tensor) -> torch.Tensor:
+    """z_ij ~ N(0, 1), i.i.d. over nodes and seeds: Φ⁻¹ of a 52-bit uniform from one hash of the seed's
+    base and the node (the node's key i P₁ + j P₂, P₂ > 2³¹: distinct for any lattice a scene reaches)."""
+    u = (((_mix(base + i * 1_000_003 + j * 2_147_483_659) >> 12) & _M52).to(torch.float64) + 0.5) * (2.0 ** -52)
+    return torch.special.ndtri(u)
+
+
+def streak_noise(x: torch.Tensor, y: torch.Tensor, seeds: Sequence[int], cos_wind: torch.Tensor, sin_wind: torch.Tensor,
+                 length_along: torch.Tensor, length_across: torch.Tensor, where: torch.Tensor | None = None) -> torch.Tensor:
+    """ν at world points (x, y) [m] (B, ...) of B images (module docstring).
+
+    Args:
+        x, y: (B, ...) [m], float32/float64 (the result's dtype); seeds: B ints.
+        cos_wind, sin_wind: (B,) the wind's direction (its axis; sign irrelevant).
+        length_along, length_across: (B,) the lattice cell [m] > 0.
+        where: bool, x's shape, or None: ν only there, 0 elsewhere (the far field, where a footprint
+            averages ν away, costs nothing).
+
+    Returns:
+        ν (B, ...), exactly N(0, 1) at every point for a random seed; continuous; differentiable in
+        x, y, the direction and the lengths (not in the node values).
+    """
+    base = _mix(torch.tensor([int(sd) for sd in seeds], dtype=torch.int64, device=x.device) * 0x5DEECE66D + 17)
+    # image by image: the transcendental functions' vectorized and scalar paths round differently, and
+    # image i of a batch must be bitwise the image rendered alone (its elements in the same places)
+    out = []
+    for i in range(x.shape[0]):
+        xd, yd = x[i].to(torch.float64), y[i].to(torch.float64)
+        if where is not None:
+            xd, yd = xd[where[i]], yd[where[i]]
+        c, s, la, lc = (t[i].to(torch.float64) for t in (cos_wind, sin_wind, length_along, length_across))
+        u = (xd * c + yd * s) / la
+        v = (yd * c - xd * s) / lc
+        iu, iv = torch.floor(u.detach()), torch.floor(v.detach())
+        fu, fv = u - iu, v - iv
+        wu = (torch.cos(0.5 * math.pi * fu), torch.sin(0.5 * math.pi * fu))
+        wv = (torch.cos(0.5 * math.pi * fv), torch.sin(0.5 * math.pi * fv))
+        i0, j0 = iu.to(torch.int64), iv.to(torch.int64)
+        nu = sum(wu[p] * wv[q] * _node_normal(base[i], i0 + p, j0 + q) for p in (0, 1) for q in (0, 1)).to(x.dtype)
+        out.append(nu if where is None else torch.zeros_like(x[i]).index_put((where[i],), nu))
+    return torch.stack(out)
