@@ -21,9 +21,12 @@ import torch
 from .spectrum import GRAVITY, dispersion, eckv_terms
 from .wave_bands import WaveBands
 
-__all__ = ["CREST_CUTOFF", "BandLattice"]
+__all__ = ["CREST_CUTOFF", "CREST_HIGHPASS", "BandLattice"]
 
-CREST_CUTOFF = 10.0  # k_b / k_p of the crest variable's low pass (WaveField docstring, *Crest variable*)
+# the crest variable's band pass (WaveField docstring, *Crest variable*): breaking crests travel at
+# c ≈ 0.2–0.5 c_p (Melville & Matusov 2002; Gemmrich, Banner & Garrett 2008), k = (c_p/c)² k_p
+CREST_CUTOFF = 25.0  # k_b / k_p of the low pass (c ≈ 0.2 c_p)
+CREST_HIGHPASS = 4.0  # k_lo / k_p of the high pass (c ≈ 0.5 c_p); 0 with CREST_CUTOFF 10 is the old low pass
 
 
 class BandLattice:
@@ -127,9 +130,13 @@ class BandLattice:
             ],
             dim=-1,
         )
-        # the crest variable (WaveField docstring): G(k) = ω²/g × |2nd-order Butterworth low pass at k_b|
-        k_b = CREST_CUTOFF * GRAVITY * omega_c**2 / wind**2  # CREST_CUTOFF × k_p (ECKV Eq. 3)
+        # the crest variable (WaveField docstring): G(k) = ω²/g × |2nd-order Butterworth band pass k_lo–k_b|
+        k_p = GRAVITY * omega_c**2 / wind**2  # ECKV Eq. 3
+        k_b = CREST_CUTOFF * k_p
         gain = self.omega**2 / GRAVITY * torch.rsqrt(1.0 + (self.k / k_b) ** 4)
+        if CREST_HIGHPASS > 0:
+            q = (self.k / (CREST_HIGHPASS * k_p)) ** 2
+            gain = gain * q * torch.rsqrt(1.0 + q**2)
         gain = torch.where(self.mask, gain, torch.zeros_like(gain))
         variance = torch.stack([weight.sum(dim=(-2, -1)), (weight * gain**2).sum(dim=(-2, -1))], dim=-1)
         return h0, cov, sign, gain, variance

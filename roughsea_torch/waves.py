@@ -27,7 +27,7 @@ from .spectrum import (C_M, GRAVITY, K_M, check_wave_age, check_wind_speed, disp
                        elfouhaily_spectrum, elfouhaily_spreading)
 from .spectrum import MAX_WIND, VON_KARMAN  # noqa: F401  (re-exported: roughsea_torch.waves.MAX_WIND as before)
 from .wave_bands import WINDOW_HI, WINDOW_LO, WaveBands, band_window
-from .wave_lattice import CREST_CUTOFF, BandLattice
+from .wave_lattice import CREST_CUTOFF, CREST_HIGHPASS, BandLattice
 
 __all__ = [
     "GRAVITY",
@@ -38,6 +38,7 @@ __all__ = [
     "elfouhaily_spreading",
     "elfouhaily_spectrum",
     "CREST_CUTOFF",
+    "CREST_HIGHPASS",
     "WaveBands",
     "WaveField",
 ]
@@ -126,22 +127,28 @@ class WaveField:
         :meth:`sample` returns at a footprint (position averages, like :meth:`resolved_covariance`).
 
     Crest variable (``sample(..., crest=True)``; where foam goes, :func:`~roughsea_torch.foam.crest_foam_fraction`):
-        X = Σ_k G(k) H(k) e^{ik·x},  G(k) = (ω(k)²/g) / √(1 + (k/k_b)⁴),  k_b = ``CREST_CUTOFF`` k_p = 10 k_p,
-        k_p = g Ω_c²/U10² (ECKV Eq. 3). For linear waves ∂²η/∂t² = −ω² η component by component,
-        so X is the downward vertical acceleration of the surface in units of g, −a_z/g, of the
-        waves from the spectral peak up to about k_b (a second-order Butterworth low pass: half
-        power at k_b, the variance per octave falling 16-fold per octave above). Dimensionless,
-        zero-mean Gaussian; each component's X is in phase with its elevation (X > 0 on crests)
-        and in quadrature with its slope, so X and the slopes at a point are uncorrelated.
-        Differentiable in the wind (k_b moves with k_p).
+        X = Σ_k G(k) H(k) e^{ik·x},  G(k) = (ω(k)²/g) q/√(1 + q²) / √(1 + (k/k_b)⁴),  q = (k/k_lo)²,
+        k_lo = ``CREST_HIGHPASS`` k_p = 4 k_p, k_b = ``CREST_CUTOFF`` k_p = 25 k_p, k_p = g Ω_c²/U10²
+        (ECKV Eq. 3). For linear waves ∂²η/∂t² = −ω² η component by component, so X is the
+        downward vertical acceleration of the surface in units of g, −a_z/g, of the waves between
+        k_lo and k_b (second-order Butterworth high and low passes, half power at each): the
+        breaking scales. Dimensionless, zero-mean Gaussian; each component's X is in phase with its
+        elevation (X > 0 on crests) and in quadrature with its slope, so X and the slopes at a point
+        are uncorrelated. Differentiable in the wind (k_lo and k_b move with k_p). Correlation
+        length along the wind at 15 m/s ≈ 4.4 m (1/e).
+
+        Band limits: breaking crests travel at c ≈ 0.2–0.5 c_p (the breaking-crest length
+        distribution Λ(c): Phillips 1985, J. Fluid Mech. 156; Melville & Matusov 2002, Nature 417,
+        58–63; Gemmrich, Banner & Garrett 2008, J. Phys. Oceanogr. 38, 1296–1312); with
+        k = (c_p/c)² k_p that is k_lo = 4 k_p (c = 0.5 c_p) and k_b = 25 k_p (c = 0.2 c_p).
+        ``CREST_HIGHPASS = 0`` with ``CREST_CUTOFF = 10`` gives the former low pass (the dominant
+        crests, tens of metres).
 
         Sources: the breaking criterion of Longuet-Higgins (1969, Proc. R. Soc. Lond. A 310,
         151–159: a crest breaks when its downward acceleration reaches g/2), made a whitecap
         probability of a Gaussian sea by Snyder & Kennedy (1983, J. Phys. Oceanogr. 13, 1482–1492)
         and Srokosz (1986, J. Phys. Oceanogr. 16, 382–385); the level comes from Monahan &
-        O'Muircheartaigh's W, not from g/2. The cut-off k_b = 10 k_p (a modelling choice, not a
-        measured constant) keeps the dominant waves and those somewhat shorter (Banner, Babanin &
-        Young 2000, J. Phys. Oceanogr. 30, 3145–3160) and leaves out the microscale breakers that
+        O'Muircheartaigh's W, not from g/2. The low pass leaves out the microscale breakers that
         entrain no air (Banner & Phillips 1974, J. Fluid Mech. 65). The reasoning, and the foam
         patches measured with this variable: ``docs/notes/wave_field.md``.
 

@@ -315,14 +315,14 @@ def test_ensemble_mean_is_the_whitecap_fraction(crest_ensemble, name, w, i):
 def test_far_field_is_the_uniform_fraction(dtype):
     """Where the footprint is much larger than the longest band (1 km, 10 km, inf: every band's window
     is exactly 0), X_r = 0, σ_r² = 0 and f_pix = W to 1e-6 (relative); and the approach is continuous:
-    at 10 m/s X's resolved part is already negligible at 300 m (|f_pix − W| < 1e-4 W), at 20 m/s
-    (waves four times longer) it is not."""
+    at 10 m/s X's resolved part (breaking scales, 4–25 k_p) is already negligible at 150 m
+    (|f_pix − W| < 1e-3 W), at 20 m/s (waves four times longer) it is not."""
     field = WaveField(torch.tensor([WIND, 20.0], dtype=torch.float64), [3, 4], dtype=dtype)
     w = whitecap_fraction(torch.tensor([WIND, 20.0], dtype=dtype))[:, None]
     gen = torch.Generator().manual_seed(4)
     x = (torch.rand(2, 1000, generator=gen, dtype=torch.float64) * 3000).to(dtype)
     y = (torch.rand(2, 1000, generator=gen, dtype=torch.float64) * 3000).to(dtype)
-    for fp, tol in ((1e3, 1e-6), (1e4, 1e-6), (math.inf, 1e-6), (300.0, 1e-4)):
+    for fp, tol in ((1e3, 1e-6), (1e4, 1e-6), (math.inf, 1e-6), (150.0, 1e-3)):
         rows = slice(None) if fp >= 1e3 else slice(0, 1)
         f_t = torch.tensor(fp, dtype=dtype)
         s = field.sample(x, y, 5.0, footprint=f_t, elevation=False, crest=True)
@@ -332,23 +332,22 @@ def test_far_field_is_the_uniform_fraction(dtype):
         if fp >= 1e3:
             assert bool((s["crest"] == 0).all()) and bool((vr == 0).all())
         assert float(((f - w) / w)[rows].abs().max()) < tol, fp
-        if fp == 300.0:
+        if fp == 150.0:
             assert float(((f - w) / w)[1].abs().max()) > 0.1  # 20 m/s: not vacuous
 
 
 @pytest.mark.usefixtures("one_thread")
 def test_foam_sits_on_crests(crest_ensemble):
-    """Foam-weighted mean of the resolved elevation E[f η_r]/E[f]: above 1.5 σ_η at the short and
-    medium footprints (measured 2.2 σ_η: the foam sits high on the crests; for η as the crest
-    variable it would be 2.67 σ_η at most, the mean of the top 1 %); correlation of f_pix with η_r
-    positive at every footprint, > 0.15 at the short one (0.23; with X_r 0.28, the indicator's
-    Gaussian value φ(c)/√(W(1 − W)) = 0.27)."""
+    """Foam-weighted mean of the resolved elevation E[f η_r]/E[f]: above 0.6 σ_η at the short and
+    medium footprints (measured 1.0 and 0.9 σ_η: X is the band 4–25 k_p, in phase with the short
+    waves' elevation, which is a fraction of η's), positive at the long one; correlation of f_pix
+    with η_r positive at every footprint, > 0.05 at the short one (0.11), with X_r > 0.2 there."""
     f = _foam(crest_ensemble, "crest", W10)
     eta, x = crest_ensemble["elevation"], crest_ensemble["crest"]
     sigma = crest_ensemble["elevation_total_variance"][..., 0].sqrt()  # (n, 1)
     lift = ((f * eta).sum(-1) / f.sum(-1) / sigma).mean(0)
-    assert bool((lift[:2] > 1.5).all()) and float(lift[2]) > 0.3, lift
-    for v, short in ((eta, 0.15), (x, 0.2)):
+    assert bool((lift[:2] > 0.6).all()) and float(lift[2]) > 0.0, lift
+    for v, short in ((eta, 0.05), (x, 0.2)):
         c = _corr(f, v)
         mean, se = c.mean(0), c.std(0) / math.sqrt(c.shape[0])
         assert bool((mean > 4 * se).all()) and float(mean[0]) > short, (mean, se)
