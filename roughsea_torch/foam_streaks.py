@@ -24,16 +24,17 @@ descriptions suggest; no measured spectrum of foam texture was used.
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from typing import Sequence
 
 import torch
+
+from .counter_hash import bits_uniform, splitmix64
 
 __all__ = ["STREAK_LENGTH_M", "STREAK_ANISOTROPY", "streak_lengths", "streak_noise", "resolved_amplitude", "resolved_share"]
 
 STREAK_LENGTH_M = 2.0  # [m] ℓ_along, the lattice cell along the wind
 STREAK_ANISOTROPY = 5.0  # ℓ_along / ℓ_across from 20 m/s (Beaufort 8–9: dense streaks)
 _RAMP = (8.0, 20.0)  # [m/s] isotropic below, fully anisotropic above (Beaufort 5 to 8–9)
-_M52 = (1 << 52) - 1
 
 
 def streak_lengths(wind_speed: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
@@ -61,20 +62,10 @@ def resolved_share(footprint: torch.Tensor | None, length_across: torch.Tensor) 
     return a * a
 
 
-def _mix(x: torch.Tensor) -> torch.Tensor:
-    """splitmix64's finalizer on int64 tensors (wrapping arithmetic; logical shifts by masking)."""
-    def shr(v: torch.Tensor, s: int) -> torch.Tensor:
-        return (v >> s) & ((1 << (64 - s)) - 1)
-    x = x + (-7046029254386353131)  # 0x9E3779B97F4A7C15 as int64
-    x = (x ^ shr(x, 30)) * (-4658895280553007687)  # 0xBF58476D1CE4E5B9
-    x = (x ^ shr(x, 27)) * (-7723592293110705685)  # 0x94D049BB133111EB
-    return x ^ shr(x, 31)
-
-
 def _node_normal(base: torch.Tensor, i: torch.Tensor, j: torch.Tensor) -> torch.Tensor:
     """z_ij ~ N(0, 1), i.i.d. over nodes and seeds: Φ⁻¹ of a 52-bit uniform from one hash of the seed's
     base and the node (the node's key i P₁ + j P₂, P₂ > 2³¹: distinct for any lattice a scene reaches)."""
-    u = (((_mix(base + i * 1_000_003 + j * 2_147_483_659) >> 12) & _M52).to(torch.float64) + 0.5) * (2.0 ** -52)
+    u = bits_uniform(splitmix64(base + i * 1_000_003 + j * 2_147_483_659))
     return torch.special.ndtri(u)
 
 
@@ -93,7 +84,7 @@ def streak_noise(x: torch.Tensor, y: torch.Tensor, seeds: Sequence[int], cos_win
         ν (B, ...), exactly N(0, 1) at every point for a random seed; continuous; differentiable in
         x, y, the direction and the lengths (not in the node values).
     """
-    base = _mix(torch.tensor([int(sd) for sd in seeds], dtype=torch.int64, device=x.device) * 0x5DEECE66D + 17)
+    base = splitmix64(torch.tensor([int(sd) for sd in seeds], dtype=torch.int64, device=x.device) * 0x5DEECE66D + 17)
     # image by image: the transcendental functions' vectorized and scalar paths round differently, and
     # image i of a batch must be bitwise the image rendered alone (its elements in the same places)
     out = []

@@ -101,8 +101,15 @@ from typing import Any, NamedTuple
 import torch
 
 from ._validation import as_tensor, check_finite_range, resolve_dtype_device
+from .counter_hash import bits_uniform, splitmix64
 from .quadrature import gauss_nodes
-from .spectrum import check_wave_age, check_wind_speed, dispersion, elfouhaily_omnidirectional, elfouhaily_spreading
+from .spectrum import (
+    check_wave_age,
+    check_wind_speed,
+    dispersion,
+    elfouhaily_omnidirectional,
+    elfouhaily_spreading,
+)
 
 __all__ = ["GLITTER_K_MAX", "GLITTER_LIFETIME_S", "GLITTER_CLUSTERING", "CurvatureMoments", "curvature_moments",
            "mean_abs_hessian_determinant", "specular_slope_density", "glitter_count", "glitter_spread",
@@ -254,31 +261,16 @@ def glitter_spread(moments: CurvatureMoments, ellipse_radius: Any, clustering: f
     return clustering * det.mean(-1) * (det * w * w).mean(-1) / (det * w).mean(-1) ** 2
 
 
-def _hash(x: torch.Tensor) -> torch.Tensor:
-    """splitmix64's finalizer on int64 tensors (wrapping arithmetic; logical shifts by masking)."""
-    def shr(v: torch.Tensor, s: int) -> torch.Tensor:
-        return (v >> s) & ((1 << (64 - s)) - 1)
-    x = x + (-7046029254386353131)  # 0x9E3779B97F4A7C15 as int64
-    x = (x ^ shr(x, 30)) * (-4658895280553007687)  # 0xBF58476D1CE4E5B9
-    x = (x ^ shr(x, 27)) * (-7723592293110705685)  # 0x94D049BB133111EB
-    return x ^ shr(x, 31)
-
-
-def _bits_uniform(h: torch.Tensor) -> torch.Tensor:
-    """A float64 in (0, 1) from the top 52 bits of ``h`` (already a hash)."""
-    return (((h >> 12) & ((1 << 52) - 1)).to(torch.float64) + 0.5) * (2.0 ** -52)
-
-
 def _uniform(key: torch.Tensor) -> torch.Tensor:
     """A float64 in (0, 1) from the hash of ``key``."""
-    return _bits_uniform(_hash(key))
+    return bits_uniform(splitmix64(key))
 
 
 def _in_time(key: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
     """z(t) of lattice nodes ``key`` (int64 hashes) at ``t`` in lifetimes: cos(πu/2) z_j + sin(πu/2) z_{j+1}
     with u = frac(t + φ), j = ⌊t + φ⌋, a phase φ (the key's own bits) and i.i.d. N(0, 1) values z_j per
     node (the inverse normal CDF of the hash of the key and j)."""
-    s = t + _bits_uniform(key)
+    s = t + bits_uniform(key)
     j = torch.floor(s)
     u = s - j
     kj = key + j.to(torch.int64) * _STEP  # (an odd multiplier: distinct steps, distinct keys)
@@ -321,14 +313,14 @@ def glitter_latent_unchecked(seed: int, x: torch.Tensor, y: torch.Tensor, footpr
     gx, gy = x / cell, y / cell
     ix, iy = torch.floor(gx), torch.floor(gy)
     ux, uy = gx - ix, gy - iy
-    base = int(_hash(torch.tensor([seed]))[0]) + level.to(torch.int64) * -4658895280553007687
+    base = int(splitmix64(torch.tensor([seed]))[0]) + level.to(torch.int64) * -4658895280553007687
     ix, iy = ix.to(torch.int64), iy.to(torch.int64)
     z = torch.zeros_like(x)
     for a in (0, 1):
         wx = torch.cos(0.5 * math.pi * ux) if a == 0 else torch.sin(0.5 * math.pi * ux)
         for b in (0, 1):
             wy = torch.cos(0.5 * math.pi * uy) if b == 0 else torch.sin(0.5 * math.pi * uy)
-            key = _hash(base + (ix + a) * -7723592293110705685 + (iy + b) * 0x5851F42D4C957F2D)
+            key = splitmix64(base + (ix + a) * -7723592293110705685 + (iy + b) * 0x5851F42D4C957F2D)
             z = z + (w_level * wx * wy * _in_time(key, t)).sum(0)
     return z
 
