@@ -12,8 +12,11 @@ cover per pixel (active red, residual cyan, square-root scaled; the per-pixel me
 the column filter): the foam's structure, which the temperatures show only faintly at near range,
 where foam and water differ by under 1 K (``docs/foam_table.md``).
 
+``--rows`` also prints, per wind and frame, the band of 6 rows with the most active foam: its range,
+its active and residual cover and the foam's brightness change (foam − no foam), to follow a patch.
+
 Usage:
-    python examples/storm_clip.py [--out docs] [--height 128] [--width 160]
+    python examples/storm_clip.py [--out docs] [--height 128] [--width 160] [--rows]
 """
 
 from __future__ import annotations
@@ -58,11 +61,29 @@ def cover(cams, wind: float, t: float) -> tuple[torch.Tensor, torch.Tensor]:
     return torch.where(sea, fa, zero)[0], torch.where(sea, fr, zero)[0]
 
 
+def print_rows(cams, wind: float, frames: list[torch.Tensor]) -> None:
+    """The 6-row band with the most active cover in each frame: range, active and residual cover, and the
+    foam's brightness change there (the frame minus the same frame without foam)."""
+    geom = rs.view_geometry(cams)
+    rng = torch.where(geom.is_sea, geom.range_m, torch.nan)[0].nanmedian(dim=1).values
+    print(f"{wind:g} m/s | t [s] | rows | range [m] | active | residual | foam − no foam [K]")
+    for t, f in zip(TIMES, frames):
+        fa, fr = cover(cams, wind, t)
+        bare = rs.render(cams, rs.SeaScene(wind_speed=wind, sea_temperature=290.0, seed=11, time_s=t, foam=False),
+                         output="brightness_temperature", table=TRAILS)[0, 0]
+        band = torch.nan_to_num(fa.mean(1)).unfold(0, 6, 6).mean(1)
+        r = 6 * int(band.argmax())
+        d = (f - bare)[r:r + 6]
+        print(f"  | {t:g} | {r}–{r + 5} | {float(rng[r + 5]):.0f}–{float(rng[r]):.0f} | {float(fa[r:r + 6].mean()):.2f} | "
+              f"{float(fr[r:r + 6].mean()):.2f} | {float(d[d == d].mean()):+.2f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "outputs" / "examples")
     ap.add_argument("--height", type=int, default=192)
     ap.add_argument("--width", type=int, default=240)
+    ap.add_argument("--rows", action="store_true", help="print the most foamy 6-row band of every frame")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     torch.set_num_threads(1)
@@ -75,6 +96,8 @@ def main() -> None:
                             output="brightness_temperature", table=TRAILS)[0, 0] for t in TIMES]
         bare = rs.render(cams, rs.SeaScene(wind_speed=wind, sea_temperature=290.0, seed=11, time_s=TIMES[-1], foam=False),
                          output="brightness_temperature", table=TRAILS)[0, 0]
+        if args.rows:
+            print_rows(cams, wind, frames)
         v = torch.cat([f[sea] for f in frames])
         lo, hi = float(v.quantile(0.005)), float(v.quantile(0.995))
         for c, (t, f) in enumerate(zip(TIMES, frames)):

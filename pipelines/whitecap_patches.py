@@ -3,7 +3,9 @@
 Connected regions of f > 0.5 on a 0.25 m grid (128 m × 128 m, one realization): median and 90th
 percentile of their extent along and across the wind; lifetimes: how long a point stays at f > 0.5
 in a 12 s clip (0.25 s steps, 48 m × 48 m, 0.5 m grid), median and 90th percentile of the runs
-that start and end inside the clip. ``--old`` uses the former low-pass gain (k_b = 10 k_p).
+that start and end inside the clip, and their mean beside the active stage's duration τ_A of
+``roughsea_torch.whitecaps.active_share`` (0.3 of the period of the crest band's centre wave).
+``--old`` uses the former low-pass gain (k_b = 10 k_p).
 
 Usage: python pipelines/whitecap_patches.py [--old]
 """
@@ -18,7 +20,9 @@ from scipy import ndimage
 
 from roughsea_torch import wave_lattice
 from roughsea_torch.foam import crest_foam_fraction, whitecap_fraction
+from roughsea_torch.spectrum import GRAVITY
 from roughsea_torch.waves import WaveField
+from roughsea_torch.whitecaps import ACTIVE_PERIOD_SHARE, BREAKING_PERIOD_RATIO, SCENE_INVERSE_WAVE_AGE
 
 STEP, SIZE = 0.25, 128.0
 
@@ -60,15 +64,16 @@ def main() -> None:
     torch.set_num_threads(1)
     if a.old:
         wave_lattice.CREST_HIGHPASS, wave_lattice.CREST_CUTOFF = 0.0, 10.0
-    print("| U10 [m/s] | patches | area f>0.5 | along median / p90 [m] | across median / p90 [m] | lifetime median / p90 [s] |")
-    print("|---|---|---|---|---|---|")
+    print("| U10 [m/s] | patches | area f>0.5 | along median / p90 [m] | across median / p90 [m] | lifetime median / p90 / mean [s] | τ_A [s] |")
+    print("|---|---|---|---|---|---|---|")
     for wind in (15.0, 25.0):
         field = WaveField(torch.tensor([wind], dtype=torch.float64), [11], dtype=torch.float64)
         w = whitecap_fraction(torch.tensor([wind], dtype=torch.float64))
         n, area, al, ac = patches(field, w)
         life = lifetimes(field, w)
         q = lambda v: f"{np.median(v):.2f} / {np.percentile(v, 90):.2f}" if len(v) else "–"
-        print(f"| {wind:.0f} | {n} | {area:.4f} | {q(al)} | {q(ac)} | {q(life)} |")
+        tau_a = ACTIVE_PERIOD_SHARE * BREAKING_PERIOD_RATIO * 2 * np.pi * wind / (GRAVITY * SCENE_INVERSE_WAVE_AGE)
+        print(f"| {wind:.0f} | {n} | {area:.4f} | {q(al)} | {q(ac)} | {q(life)} / {life.mean():.2f} | {tau_a:.2f} |")
 
 
 if __name__ == "__main__":

@@ -32,10 +32,17 @@ Sources and numbers
   geometric middle of that range.
 - Whitecap lifetimes are exponentially distributed, about 0.3 of the breaking wave's period
   (Korinenko, Malinovsky, Dulov & Kudryavtsev, Black Sea platform video): taken here as the active
-  stage's duration τ_A = 0.3 T_p at the spectral peak (T_p = 2π U10 / (g Ω_c), ECKV's k_p), and the
-  active share of the cover by Little's law for two successive stages, a = τ_A / (τ_A + τ_R)
-  (:func:`active_share`; 0.63 at 15 m/s, fully developed). That the video lifetime is the active
-  stage's, and that the peak's period sets it, are this model's assumptions.
+  stage's duration τ_A = 0.3 T_b, T_b the period of the waves whose crests break in this model: the
+  crest variable's band k_lo–k_b (:data:`~roughsea_torch.wave_lattice.CREST_HIGHPASS` = 4 k_p to
+  :data:`~roughsea_torch.wave_lattice.CREST_CUTOFF` = 25 k_p, the breaking crests' speeds
+  0.2–0.5 c_p of Melville & Matusov 2002), at its geometric centre k_c = √(k_lo k_b) = 10 k_p, so by
+  deep-water dispersion T_b = T_p (k_p / k_c)^½ = 0.32 T_p (T_p = 2π U10 / (g Ω_c), ECKV's k_p).
+  The active share of the cover follows by Little's law for two successive stages,
+  a = τ_A / (τ_A + τ_R) (:func:`active_share`; 0.35 at 15 m/s, 0.47 at 25 m/s, fully developed).
+  τ_A = 1.09 s (15 m/s) and 1.81 s (25 m/s) are close to how long the crest foam itself stays at a
+  point of sampled fields, 0.64 s and 1.78 s in the mean (``pipelines/whitecap_patches.py``); the
+  peak's period would give 3.4 s and 5.7 s. That the video lifetime is the active stage's is this
+  model's assumption.
 - Foam drifts with the surface water: about 3.5 % of U10 downwind at long fetch (Wu 1975, J. Fluid
   Mech. 68, 49–70, total surface drift including the Stokes drift): :data:`DRIFT_SHARE`.
 
@@ -98,10 +105,12 @@ from .foam import crest_fraction_from_variances, foam_radiance
 from .foam_streaks import resolved_amplitude, streak_lengths, streak_noise
 from .radiometry import band_radiance, brightness_temperature
 from .spectrum import GRAVITY
+from .wave_lattice import CREST_CUTOFF, CREST_HIGHPASS
 
 __all__ = [
     "RESIDUAL_DECAY_S",
     "ACTIVE_PERIOD_SHARE",
+    "BREAKING_PERIOD_RATIO",
     "DRIFT_SHARE",
     "DEPOSIT_INTERVAL_S",
     "DEPOSIT_WINDOW",
@@ -119,7 +128,9 @@ __all__ = [
 ]
 
 RESIDUAL_DECAY_S = 2.0  # [s] τ_R, Callaghan et al. 2012: 0.5–8 s (geometric middle)
-ACTIVE_PERIOD_SHARE = 0.3  # τ_A / T_p, Korinenko et al.: whitecap lifetime / breaking wave period
+ACTIVE_PERIOD_SHARE = 0.3  # τ_A / T_b, Korinenko et al.: whitecap lifetime / breaking wave period
+# T_b / T_p: the period of the crest band's centre wavenumber √(k_lo k_b), deep-water dispersion T ∝ k^(-1/2)
+BREAKING_PERIOD_RATIO = (max(CREST_HIGHPASS, 1.0) * CREST_CUTOFF) ** -0.25
 DRIFT_SHARE = 0.035  # surface drift / U10, Wu 1975 (long fetch)
 DEPOSIT_INTERVAL_S = 0.5  # [s] Δ, the spacing of the residual foam's deposit epochs
 DEPOSIT_WINDOW = 3.0  # deposits kept within this many τ_R before t (the rest, e^-3 = 5 %, renormalized away)
@@ -136,7 +147,7 @@ SCENE_INVERSE_WAVE_AGE = 0.84  # Ω_c of a SeaScene's wave fields (fully develop
 
 def active_share(wind_speed: torch.Tensor, inverse_wave_age: torch.Tensor,
                  decay_s: float = RESIDUAL_DECAY_S) -> torch.Tensor:
-    """a = τ_A / (τ_A + τ_R), τ_A = 0.3 T_p, T_p = 2π U10 / (g Ω_c) [s] (module docstring).
+    """a = τ_A / (τ_A + τ_R), τ_A = 0.3 T_b, T_b = 0.32 T_p, T_p = 2π U10 / (g Ω_c) [s] (module docstring).
 
     Args:
         wind_speed: U10 [m/s] > 0, tensor (B,); inverse_wave_age: Ω_c, tensor (B,).
@@ -145,7 +156,7 @@ def active_share(wind_speed: torch.Tensor, inverse_wave_age: torch.Tensor,
     Returns:
         a in (0, 1), (B,), differentiable in the wind.
     """
-    tau_a = ACTIVE_PERIOD_SHARE * 2.0 * math.pi * wind_speed / (GRAVITY * inverse_wave_age)
+    tau_a = ACTIVE_PERIOD_SHARE * BREAKING_PERIOD_RATIO * 2.0 * math.pi * wind_speed / (GRAVITY * inverse_wave_age)
     return tau_a / (tau_a + decay_s)
 
 

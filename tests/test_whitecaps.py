@@ -35,10 +35,14 @@ def test_deposit_epochs_are_fixed_in_time_and_exponentially_weighted():
 
 
 def test_active_share_little_law():
-    """a = τ_A/(τ_A + τ_R), τ_A = 0.3 T_p, T_p = 2π U/(g Ω): at 15 m/s, Ω = 0.84, T_p = 11.44 s, a = 0.632."""
+    """a = τ_A/(τ_A + τ_R), τ_A = 0.3 T_b, T_b the period of the crest band's centre 10 k_p (√(4 k_p · 25 k_p)):
+    T_b = T_p/√10 by deep-water dispersion; at 15 m/s, Ω = 0.84, T_p = 11.44 s, τ_A = 1.085 s, a = 0.352
+    (planted: τ_A = 0.3 T_p, the peak's period, gives a = 0.632 and fails)."""
     a = active_share(torch.tensor([15.0], dtype=D), torch.tensor([0.84], dtype=D))
     tp = 2 * math.pi * 15.0 / (9.81 * 0.84)
-    assert float(a) == pytest.approx(0.3 * tp / (0.3 * tp + 2.0), rel=1e-3)
+    tau_a = 0.3 * tp / math.sqrt(10.0)
+    assert float(a) == pytest.approx(tau_a / (tau_a + 2.0), rel=1e-3)
+    assert float(a) == pytest.approx(0.352, abs=2e-3)
 
 
 @pytest.fixture(scope="module")

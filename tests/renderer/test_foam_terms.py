@@ -101,10 +101,11 @@ def test_foam_by_day_also_reflects_the_scattered_sky():
     rb = rs.band_radiance(torch.tensor(290.0, dtype=torch.float64), rs.MWIR)
     want = foam_radiance(g.view_zenith[0], rs.MWIR, rb, e_day + e_thermal, refractive_index=(m.real, m.imag))
     # the expectation's foam is the mean over the states, a R_act + (1 − a) R_res: active foam at the bulk
-    # temperature 290.2 K (skin deficit 0.2 K), a = τ_A/(τ_A + τ_R), τ_A = 0.3 · 2π U/(g Ω_c), τ_R = 2 s
+    # temperature 290.2 K (skin deficit 0.2 K), a = τ_A/(τ_A + τ_R), τ_A = 0.3 · 2π U/(g Ω_c) / √10 (the period of
+    # the breaking band's centre, 10 k_p), τ_R = 2 s
     rb_bulk = rs.band_radiance(torch.tensor(290.2, dtype=torch.float64), rs.MWIR)
     act = foam_radiance(g.view_zenith[0], rs.MWIR, rb_bulk, e_day + e_thermal, refractive_index=(m.real, m.imag))
-    tau_a = 0.3 * 2 * math.pi * 3.0 / (9.81 * 0.84)
+    tau_a = 0.3 * 2 * math.pi * 3.0 / (9.81 * 0.84) / math.sqrt(10.0)
     want = want + tau_a / (tau_a + 2.0) * (act - want)
     torch.testing.assert_close(r_foam, want, rtol=1e-6, atol=0)
 
