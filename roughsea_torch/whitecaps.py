@@ -70,9 +70,10 @@ Radiance of the two states (:func:`foam_state_radiances`)
 
 so R_act − R_res = ε_f (R_B(T + ΔT_skin) − R_B(T)) > 0: active whitecaps are brighter than residual
 foam at every view angle. T is the scene's sea temperature, the radiating SKIN's; active breaking
-mixes the cool skin away and the foam radiates at the bulk temperature T + ΔT_skin, ΔT_skin =
-:data:`SKIN_DEFICIT_K` = 0.2 K: the skin is "a few tenths of a degree" cooler than the water below
-(Jessup, Zappa & Yeh 1997, J. Geophys. Res. 102, C10, 23145–23153, and Nature 385, 52–55: breaking
+mixes the cool skin away and the foam radiates at the bulk temperature T + ΔT_skin (a scene's
+``skin_deficit``, by default :data:`SKIN_DEFICIT_K` = 0.2 K, accepted in [0, 5] K): the skin is "a few
+tenths of a degree" cooler than the water below (Jessup, Zappa & Yeh 1997, J. Geophys. Res. 102, C10,
+23145–23153, and Nature 385, 52–55: breaking
 disrupts it, infrared imagery sees the warm wake recover over seconds), typically about 0.2 K and
 up to 0.5 K under strong cooling. Both states get the measured foam emissivity ε_f and the reflected
 sky S of :mod:`roughsea_torch.foam`: Marmorino & Smith (2005, Geophys. Res. Lett. 32, L11604) report
@@ -101,6 +102,7 @@ from typing import Any
 
 import torch
 
+from ._validation import check_finite_range
 from .foam import crest_fraction_from_variances, foam_radiance
 from .foam_streaks import resolved_amplitude, streak_lengths, streak_noise
 from .radiometry import band_radiance, brightness_temperature
@@ -117,10 +119,12 @@ __all__ = [
     "TRAILS_FROM",
     "TRAILS_FULL",
     "SKIN_DEFICIT_K",
+    "MAX_SKIN_DEFICIT_K",
     "STREAK_VARIANCE_SHARE",
     "SCENE_INVERSE_WAVE_AGE",
     "active_share",
     "skin_disrupted_radiance",
+    "check_skin_deficit",
     "foam_state_radiances",
     "deposit_epochs",
     "foam_drift",
@@ -142,6 +146,7 @@ TRAILS_FROM = 1e-3  # W, about 5 m/s (Monahan & O'Muircheartaigh 1980)
 TRAILS_FULL = 3e-3  # W, about 7 m/s
 STREAK_VARIANCE_SHARE = 0.5  # κ: var(s ν) / σ_X², the streak field's share beside the crest variable
 SKIN_DEFICIT_K = 0.2  # [K] bulk − skin temperature, disrupted by active breaking (Jessup, Zappa & Yeh 1997)
+MAX_SKIN_DEFICIT_K = 5.0  # [K] the largest skin deficit accepted (SeaScene(skin_deficit=), foam_state_radiances)
 SCENE_INVERSE_WAVE_AGE = 0.84  # Ω_c of a SeaScene's wave fields (fully developed, WaveField's default)
 
 
@@ -160,19 +165,34 @@ def active_share(wind_speed: torch.Tensor, inverse_wave_age: torch.Tensor,
     return tau_a / (tau_a + decay_s)
 
 
-def skin_disrupted_radiance(sea_radiance: torch.Tensor, band: Any, deficit_k: float = SKIN_DEFICIT_K) -> torch.Tensor:
+def skin_disrupted_radiance(sea_radiance: torch.Tensor, band: Any,
+                            deficit_k: float | torch.Tensor = SKIN_DEFICIT_K) -> torch.Tensor:
     """R_B(T + ΔT_skin) [W m⁻² sr⁻¹]: the blackbody band radiance of the bulk water that active breaking
     brings to the surface, T the brightness temperature of ``sea_radiance`` (the skin's R_B(T)) in
-    ``band``, ΔT_skin = ``deficit_k`` [K] (module docstring). Shape, dtype and device of ``sea_radiance``;
-    differentiable."""
-    if deficit_k == 0:  # the skin's own radiance, exactly (no round trip through the temperature)
-        return sea_radiance
+    ``band``, ΔT_skin = ``deficit_k`` [K] (module docstring): a float, or a tensor broadcasting with
+    ``sea_radiance`` (differentiable in it). Shape, dtype and device of their broadcast; differentiable.
+    Where ΔT_skin = 0 the result is ``sea_radiance`` itself, bit for bit (no round trip through the
+    temperature), its derivative in ΔT_skin still dR_B/dT."""
+    if not isinstance(deficit_k, torch.Tensor):
+        if deficit_k == 0:  # the skin's own radiance, exactly
+            return sea_radiance
+        t = brightness_temperature(sea_radiance.clamp_min(1e-30), band)
+        return band_radiance(t + deficit_k, band).to(sea_radiance.dtype)
+    d = deficit_k.to(dtype=sea_radiance.dtype, device=sea_radiance.device)
     t = brightness_temperature(sea_radiance.clamp_min(1e-30), band)
-    return band_radiance(t + deficit_k, band).to(sea_radiance.dtype)
+    bulk = band_radiance(t + d, band).to(sea_radiance.dtype)
+    # where ΔT = 0: R_B(T) + (R_B(T + ΔT) − R_B(T)), the skin's radiance exactly, with the derivative in ΔT
+    return torch.where(d == 0, sea_radiance + (bulk - band_radiance(t, band).to(sea_radiance.dtype)), bulk)
+
+
+def check_skin_deficit(name: str, deficit_k: Any) -> None:
+    """``ValueError`` naming ``name`` unless ``deficit_k`` (a float or tensor) is a skin temperature deficit
+    in [0, :data:`MAX_SKIN_DEFICIT_K`] K, finite."""
+    check_finite_range(name, deficit_k, 0.0, MAX_SKIN_DEFICIT_K, unit="K (the bulk − skin temperature)")
 
 
 def foam_state_radiances(view_zenith: torch.Tensor, band: Any, sea_radiance: torch.Tensor, sky: torch.Tensor,
-                         refractive_index: Any = None, deficit_k: float = SKIN_DEFICIT_K,
+                         refractive_index: Any = None, deficit_k: float | torch.Tensor = SKIN_DEFICIT_K,
                          bulk_radiance: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
     """(R_act, R_res) [W m⁻² sr⁻¹]: active foam ε_f R_B(T + ΔT_skin) + (1 − ε_f) S and residual foam
     ε_f R_B(T) + (1 − ε_f) S (module docstring; ε_f, S: :func:`~roughsea_torch.foam.foam_radiance`).
@@ -181,15 +201,14 @@ def foam_state_radiances(view_zenith: torch.Tensor, band: Any, sea_radiance: tor
         view_zenith: θ̂ [rad] in [0, π/2]; band: the sensor band (MWIR or LWIR).
         sea_radiance: R_B(T) of the skin [W m⁻² sr⁻¹] > 0; sky: S, the sky the foam reflects, ≥ 0.
         refractive_index: the water's (see :func:`~roughsea_torch.foam.foam_emissivity`).
-        deficit_k: ΔT_skin [K] ≥ 0.
+        deficit_k: ΔT_skin [K] in [0, 5], a float or a tensor broadcasting with ``sea_radiance``.
         bulk_radiance: R_B(T + ΔT_skin) if already computed (:func:`skin_disrupted_radiance`), else None.
     All broadcast together; float32/float64 and device follow the inputs.
 
     Returns:
         R_act, R_res of the broadcast shape; R_act ≥ R_res (equal for ``deficit_k`` = 0).
     """
-    if not (isinstance(deficit_k, (int, float)) and math.isfinite(deficit_k) and 0.0 <= deficit_k <= 5.0):
-        raise ValueError(f"deficit_k must be a skin temperature deficit in [0, 5] K; got {deficit_k!r}")
+    check_skin_deficit("deficit_k", deficit_k)
     residual = foam_radiance(view_zenith, band, sea_radiance, sky, refractive_index=refractive_index)
     bulk = skin_disrupted_radiance(sea_radiance, band, deficit_k) if bulk_radiance is None else bulk_radiance
     active = foam_radiance(view_zenith, band, bulk, sky, refractive_index=refractive_index)

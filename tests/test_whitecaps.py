@@ -13,7 +13,7 @@ import roughsea_torch as rs
 from roughsea_torch.foam import crest_foam_fraction, whitecap_fraction
 from roughsea_torch.waves import WaveField
 from roughsea_torch.whitecaps import (DEPOSIT_INTERVAL_S, RESIDUAL_DECAY_S, TRAILS_FROM, TRAILS_FULL, active_share,
-                                     foam_state_radiances,
+                                     foam_state_radiances, skin_disrupted_radiance,
                                      deposit_epochs, whitecap_cover)
 
 from conftest import make_cams
@@ -180,6 +180,31 @@ def test_active_foam_is_brighter_than_residual_by_the_skin_deficit(band, dtype, 
     torch.testing.assert_close(gap[near], 0.2 * eps[near], rtol=0.05, atol=0)
 
 
+@pytest.mark.parametrize("dtype,tol", [(torch.float64, 1e-9), (torch.float32, 1e-5)])
+def test_skin_deficit_per_image_tensor_against_the_reference(dtype, tol):
+    """skin_disrupted_radiance with a tensor ΔT_skin per image (0, 0.5 and 5 K, the range's ends): R_B(T + ΔT)
+    of the numpy reference's Planck band integral at 290 K + ΔT; at ΔT = 0 the skin's radiance bit for bit,
+    and dR/dΔT = dR_B/dT(T + ΔT) there too (a numpy central difference of the reference, to 1e-6;
+    a shortcut returning the input at 0 would give 0). foam_state_radiances refuses a tensor deficit
+    outside [0, 5] K, naming deficit_k."""
+    from roughsea_torch.reference import planck
+
+    band = tuple(rs.LWIR)
+    rb = rs.band_radiance(torch.full((3,), 290.0, dtype=dtype), rs.LWIR)
+    d = torch.tensor([0.0, 0.5, 5.0], dtype=dtype, requires_grad=True)
+    bulk = skin_disrupted_radiance(rb, rs.LWIR, d)
+    want = planck.band_radiance(290.0 + d.detach().double().numpy(), band)
+    torch.testing.assert_close(bulk.double(), torch.tensor(want), rtol=tol, atol=0)
+    assert torch.equal(bulk[0], rb[0])
+    (grad,) = torch.autograd.grad(bulk.sum(), d)
+    t = 290.0 + d.detach().double().numpy()
+    slope = (planck.band_radiance(t + 1e-3, band) - planck.band_radiance(t - 1e-3, band)) / 2e-3
+    torch.testing.assert_close(grad.double(), torch.tensor(slope), rtol=1e-6 if dtype == torch.float64 else 1e-3, atol=0)
+    with pytest.raises(ValueError, match=r"^deficit_k must lie in \[0, 5\] K"):
+        foam_state_radiances(torch.zeros(3, dtype=dtype), rs.LWIR, rb, torch.tensor(20.0, dtype=dtype),
+                             deficit_k=torch.tensor([0.2, 0.2, 5.5], dtype=dtype))
+
+
 def test_foam_state_gradients_are_finite():
     """d/dT_sea and d/dU of a textured storm's foam radiance mean, float32 and float64, at a grazing view."""
     for dtype in (torch.float32, torch.float64):
@@ -192,17 +217,14 @@ def test_foam_state_gradients_are_finite():
         assert torch.isfinite(t.grad) and torch.isfinite(u.grad).all() and float(t.grad) > 0
 
 
-def test_textured_ensemble_mean_weights_the_two_states_as_the_expectation(monkeypatch):
+def test_textured_ensemble_mean_weights_the_two_states_as_the_expectation():
     """With an exaggerated skin deficit (4 K, so that the states differ by ~4 % of the radiance), the
     mean over 12 realizations of a 20 m/s storm's sea pixels (default covers, no trails) equals the
     expectation image's, whose foam is a R_act + (1 − a) R_res, within 1e-3 (measured 4.3e-5; the
     sampling error of the test above); an expectation with the residual's radiance alone is 4e-3 off
     (planted: a = 0 in renderer.foam_terms.active_share_of_images fails)."""
-    from roughsea_torch.renderer import foam_terms
-
-    monkeypatch.setattr(foam_terms, "SKIN_DEFICIT_K", 4.0)
     cams = make_cams(16, 24, pitch_deg=-8.0, batch_size=12, hfov_deg=20.0, altitude_m=15.0)
-    kw = dict(wind_speed=20.0, sea_temperature=290.0, path=False)
+    kw = dict(wind_speed=20.0, sea_temperature=290.0, path=False, skin_deficit=4.0)
     tex = rs.render(cams, rs.SeaScene(**kw, seed=list(range(40, 52)), time_s=0.7))
     mean = rs.render(cams, rs.SeaScene(**kw))
     sea = rs.view_geometry(cams).is_sea[:, None]

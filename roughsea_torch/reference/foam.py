@@ -137,7 +137,8 @@ def foam_state_radiances(view_zenith, band, sea_temperature, sky_radiance, refra
     return eps * b_bulk + (1.0 - eps) * sky_radiance, eps * b_skin + (1.0 - eps) * sky_radiance
 
 
-def foam_mean_radiance(view_zenith, band, sea_temperature, sky_radiance, active_share, refractive_index=None):
+def foam_mean_radiance(view_zenith, band, sea_temperature, sky_radiance, active_share, refractive_index=None,
+                       deficit_k=SKIN_DEFICIT_K):
     """The expectation's foam radiance a R_act + (1 - a) R_res, a the active share of the cover."""
-    act, res = foam_state_radiances(view_zenith, band, sea_temperature, sky_radiance, refractive_index)
+    act, res = foam_state_radiances(view_zenith, band, sea_temperature, sky_radiance, refractive_index, deficit_k)
     return active_share * act + (1.0 - active_share) * res

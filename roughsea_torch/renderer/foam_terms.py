@@ -1,7 +1,8 @@
 """Whitecaps in a render: the foam's radiances per image and their mix with the sea.
 
 Two foam states (:mod:`roughsea_torch.whitecaps`): active whitecaps on the breaking crests, radiating at
-the bulk temperature (the cool skin disrupted), and residual foam at the skin's,
+the bulk temperature (the cool skin disrupted; ΔT_skin the scene's ``skin_deficit``, 0.2 K by default),
+and residual foam at the skin's,
 
     R_act = ε_f R_B(T + ΔT_skin) + (1 − ε_f) S,   R_res = ε_f R_B(T) + (1 − ε_f) S
 
@@ -23,8 +24,7 @@ import torch
 from .._validation import per_batch
 from ..foam import foam_sky_weights
 from ..sky import select_sky
-from ..whitecaps import (SCENE_INVERSE_WAVE_AGE, SKIN_DEFICIT_K, active_share, foam_state_radiances,
-                         skin_disrupted_radiance)
+from ..whitecaps import SCENE_INVERSE_WAVE_AGE, active_share, foam_state_radiances, skin_disrupted_radiance
 from .scene import SceneParameters, SeaScene
 from .sky_terms import day_sky
 
@@ -51,10 +51,12 @@ def foam_state_radiances_of_images(theta: torch.Tensor, p: SceneParameters, idx:
         e_sky = e_sky[(...,) + extra]
     # R_B(T + ΔT_skin) image by image (the transcendental functions' vectorized and scalar paths round
     # differently, and image i of a batch must be bitwise the image rendered alone), then per element
-    bulk = torch.cat([skin_disrupted_radiance(p.rb[i:i + 1], scene.band, SKIN_DEFICIT_K) for i in range(p.rb.shape[0])])
+    # (ΔT_skin the scene's skin_deficit, per image)
+    bulk = torch.cat([skin_disrupted_radiance(p.rb[i:i + 1], scene.band, p.skin_deficit[i:i + 1])
+                      for i in range(p.rb.shape[0])])
     act, res = foam_state_radiances(theta, scene.band, p.rb[idx][(...,) + extra].to(dtype), e_sky,
                                     refractive_index=(p.n[idx][(...,) + extra], p.k[idx][(...,) + extra]),
-                                    deficit_k=SKIN_DEFICIT_K, bulk_radiance=bulk[idx][(...,) + extra].to(dtype))
+                                    deficit_k=p.skin_deficit, bulk_radiance=bulk[idx][(...,) + extra].to(dtype))
     return act.to(dtype), res.to(dtype)
 
 

@@ -25,6 +25,7 @@ from ..slopes import MAX_WIND_SPEED, SlopeStatistics
 from ..solar import load_solar_irradiance
 from ..sun import Sun
 from ..waves import MAX_WIND_DIRECTION, WaveField, check_time
+from ..whitecaps import SKIN_DEFICIT_K, check_skin_deficit
 from .settings import TableSize
 
 __all__ = ["SeaScene", "SceneParameters", "check_foam"]
@@ -42,6 +43,7 @@ class SceneParameters:
         sky: the scene's sky (a callable of cos(zenith); a ``TabulatedSky`` or ``ConstantSky`` may
             hold one row per image).
         foam: (B,) the whitecap fraction, or None where no image has foam.
+        skin_deficit: (B,) ΔT_skin [K], the bulk − skin temperature of the active whitecaps.
         air_scale: (B,) B(T_air)/B(T_atm), the factor on the sky and path radiance of a named
             atmosphere whose surface air is set (``SeaScene(air_temperature=)``), or None.
     """
@@ -56,6 +58,7 @@ class SceneParameters:
     sky: Any
     foam: torch.Tensor | None
     air_scale: torch.Tensor | None
+    skin_deficit: torch.Tensor
 
     @property
     def batch_size(self) -> int:
@@ -190,6 +193,12 @@ class SeaScene:
             the resolved waves (:func:`roughsea_torch.foam.crest_foam_fraction`; its mean over
             realizations is f, and it is f where the pixel resolves no waves), and mixes
             pixel = (1 − f_pix) · (sea + texture + glint) + f_pix · foam.
+        skin_deficit: ΔT_skin [K], the bulk − skin temperature, float or (B,) tensor in [0, 5] K (default
+            :data:`~roughsea_torch.whitecaps.SKIN_DEFICIT_K` = 0.2 K): ``sea_temperature`` is the
+            radiating skin's, a few tenths of a kelvin cooler than the water below (Jessup, Zappa & Yeh
+            1997, J. Geophys. Res. 102, C10, 23145–23153: about 0.2 K, up to 0.5 K under strong cooling);
+            active breaking mixes the skin away, so active whitecaps radiate at T_sea + ΔT_skin and
+            residual foam at T_sea (:mod:`roughsea_torch.whitecaps`). 0: both at T_sea. Differentiable.
 
     Example:
         >>> scene = SeaScene(wind_speed=torch.tensor([3.0, 12.0]), wind_direction=0.5,
@@ -198,7 +207,7 @@ class SeaScene:
         2
     """
 
-    def __init__(  # ~100 lines: the signature (26 keyword arguments) and one check or conversion per argument
+    def __init__(  # ~100 lines: the signature (23 keyword arguments) and one check or conversion per argument
         self,
         *,
         slopes: SlopeStatistics | None = None,
@@ -223,6 +232,7 @@ class SeaScene:
         sky_masking: bool = False,
         foam: Any = "auto",
         aerosol: Any = "maritime",
+        skin_deficit: Any = SKIN_DEFICIT_K,
     ):
         if (slopes is None) == (wind_speed is None):
             raise ValueError("SeaScene: give exactly one of slopes= or wind_speed=")
@@ -299,6 +309,7 @@ class SeaScene:
         self.sun_masking = sun_masking
         self.sky_masking = bool(sky_masking)
         self.foam = check_foam(foam)
+        self.skin_deficit = skin_deficit  # checked by its setter
         self.seed = seed
         self._wave_fields: dict[Any, Any] = {}
 
@@ -316,6 +327,21 @@ class SeaScene:
         if isinstance(value, (torch.Tensor, np.ndarray)) and value.ndim > 1:
             raise ValueError(f"time_s: must be a float or a tensor of shape (B,); got shape {tuple(value.shape)}")
         self._time_s = value
+
+    @property
+    def skin_deficit(self) -> Any:
+        """ΔT_skin [K], the active whitecaps' bulk − skin temperature: a float or (B,) tensor in [0, 5] K."""
+        return self._skin_deficit
+
+    @skin_deficit.setter
+    def skin_deficit(self, value: Any) -> None:  # checked on every assignment, as time_s
+        if isinstance(value, (list, tuple)):
+            raise ValueError("skin_deficit: give a float or a tensor of shape (B,), one value per image; got a "
+                             f"{type(value).__name__} (use torch.tensor(...))")
+        check_skin_deficit("skin_deficit", value)
+        if isinstance(value, (torch.Tensor, np.ndarray)) and value.ndim > 1:
+            raise ValueError(f"skin_deficit: must be a float or a tensor of shape (B,); got shape {tuple(value.shape)}")
+        self._skin_deficit = value
 
     @property
     def sun(self) -> Any:
@@ -375,7 +401,7 @@ class SeaScene:
                       self.slopes.var_upwind, self.slopes.var_crosswind, self.slopes.cov),
                   "wind_direction": (self.wind_direction,), "sea_temperature": (self.sea_temperature,),
                   "sea_radiance": (self.sea_radiance,), "air_temperature": (self.air_temperature,),
-                  "time_s": (self.time_s,)}
+                  "time_s": (self.time_s,), "skin_deficit": (self.skin_deficit,)}
         out = {}
         for name, values in fields.items():
             for v in values:
@@ -478,4 +504,5 @@ class SeaScene:
         if foam is not None and not bool((foam > 0).any()):
             foam = None  # no foam anywhere: leave it out
         return SceneParameters(vx=vx, vy=vy, cxy=cxy, wind_direction=wd, rb=rb, n=n.expand(B), k=k.expand(B), sky=self.sky,
-                               foam=foam, air_scale=air_scale)
+                               foam=foam, air_scale=air_scale,
+                               skin_deficit=per_batch("skin_deficit", self.skin_deficit, B, dtype, device))

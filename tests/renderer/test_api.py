@@ -29,17 +29,15 @@ def test_rotating_wind_and_camera_together_leaves_the_image_unchanged():
     assert (a - c).abs().max() > 1e-3
 
 
-def test_second_law_whole_image_is_uniform_brightness_temperature(monkeypatch):
+def test_second_law_whole_image_is_uniform_brightness_temperature():
     """Sky radiance equal to the sea's blackbody radiance everywhere ⇒ every pixel, sea or sky, is
     at the sea temperature (Eq. 10 with R_s ≡ R_B, through geometry, tables and grid_sample; the active
     whitecaps' skin deficit set to 0, so that the foam too is at the sea temperature)."""
-    from roughsea_torch.renderer import foam_terms
-
-    monkeypatch.setattr(foam_terms, "SKIN_DEFICIT_K", 0.0)
     t_sea = 291.5
     rb = float(rs.band_radiance(torch.tensor(t_sea, dtype=torch.float64)))
     cams = varied_cameras(torch.float64, 32, 40)
-    scene = rs.SeaScene(wind_speed=torch.tensor([1.0, 5.0, 10.0, 20.0, 30.0]), sea_temperature=t_sea, sky=rb)
+    scene = rs.SeaScene(wind_speed=torch.tensor([1.0, 5.0, 10.0, 20.0, 30.0]), sea_temperature=t_sea, sky=rb,
+                        skin_deficit=0.0)
     with pytest.warns(UserWarning, match="above 25 m/s"):  # 30 m/s: the whitecap law is held at 25 m/s
         bt = rs.render(cams, scene, output="brightness_temperature")
     torch.testing.assert_close(bt, torch.full_like(bt, t_sea), rtol=0, atol=1e-9)

@@ -17,7 +17,6 @@ import roughsea_torch as rs
 import roughsea_torch.reference as ref
 from roughsea_torch.foam import whitecap_fraction
 from roughsea_torch.radiometry import as_band
-from roughsea_torch.renderer import foam_terms
 from roughsea_torch.solar import load_solar_irradiance
 
 from conftest import TIME_RANGE, horizon_sky, make_cams, make_scene, planck_band, smooth_sky
@@ -64,16 +63,16 @@ def test_default_scene_with_named_atmosphere_and_path(dtype):
     assert 0.5 < float(mst.sky(torch.tensor(1.0))) < 1.2  # the MWIR sky, not the LWIR one
 
 
-def test_scene_sea_radiance_is_the_band_radiance_of_its_own_band(monkeypatch):
+def test_scene_sea_radiance_is_the_band_radiance_of_its_own_band():
     """A 290 K sea under a sky of the same band radiance (no path): every pixel, sea or sky, is the
     band radiance of a 290 K blackbody in the scene's band, from Planck integrated here (MWIR
     3–5 µm: 1.28 W m⁻² sr⁻¹; LWIR: 32.5 W m⁻² sr⁻¹; a scene given the other band's sea radiance is off
     by 25×), and its brightness temperature is 290 K. (The LWIR default is exercised by every
     other scene test.)"""
-    monkeypatch.setattr(foam_terms, "SKIN_DEFICIT_K", 0.0)  # active whitecaps at the sea's temperature too
     band = (3e-6, 5e-6)
     L = planck_band(290.0, *band)
-    scene = make_scene(wind_speed=torch.tensor(6.0, dtype=F64), band=band, sky=L, path=False)
+    # skin_deficit=0: active whitecaps at the sea's temperature too
+    scene = make_scene(wind_speed=torch.tensor(6.0, dtype=F64), band=band, sky=L, path=False, skin_deficit=0.0)
     cams = make_cams(hfov_deg=40.0, pitch_deg=-2.0, roll_deg=0.0, batch_size=1)
     geom = rs.view_geometry(cams)
     assert bool(geom.is_sea.any()) and bool((~geom.is_sea).any())
@@ -83,18 +82,17 @@ def test_scene_sea_radiance_is_the_band_radiance_of_its_own_band(monkeypatch):
     np.testing.assert_allclose(bt.numpy(), 290.0, rtol=0, atol=1e-4)
 
 
-def test_scene_response_shapes_the_sea_radiance(monkeypatch):
+def test_scene_response_shapes_the_sea_radiance():
     """A tabulated spectral response (the reference integrates it with scipy): a 295 K sea under a
     sky equal to that response-weighted band radiance renders that radiance everywhere; the flat
     band's would differ by ~30 %."""
-    monkeypatch.setattr(foam_terms, "SKIN_DEFICIT_K", 0.0)  # active whitecaps at the sea's temperature too
     wl = np.array([7.5e-6, 8.5e-6, 10e-6, 11.5e-6, 12.5e-6])
     resp = np.array([0.0, 0.9, 1.0, 0.7, 0.0])
     band = (7.5e-6, 12.5e-6)
     L = float(ref.band_radiance(295.0, band, (wl, resp)))
     assert abs(L / float(ref.band_radiance(295.0, band)) - 1) > 0.1
     scene = rs.SeaScene(wind_speed=torch.tensor(6.0, dtype=F64), sea_temperature=295.0, band=band, response=(wl, resp),
-                        sky=L, path=False)
+                        sky=L, path=False, skin_deficit=0.0)  # active whitecaps at the sea's temperature too
     img = rs.render(make_cams(hfov_deg=40.0, pitch_deg=-2.0, roll_deg=0.0, batch_size=1), scene)
     np.testing.assert_allclose(img.numpy(), L, rtol=1e-6)
 
@@ -274,6 +272,31 @@ def test_wind_direction_reports_its_real_range(bad):
     for seed in (1, None):
         with pytest.raises(ValueError, match=r"wind_direction must lie in \[-1e\+06, 1e\+06\] rad"):
             seeded_scene(wind_direction=bad, seed=seed)
+
+
+@pytest.mark.parametrize("bad", [-0.1, 5.1, float("nan"), float("inf"), float("-inf"), torch.tensor([0.2, -1.0]),
+                                 np.array([0.2, 7.0])])
+def test_skin_deficit_outside_0_to_5_kelvin_is_refused(bad):
+    """SeaScene(skin_deficit=): a ValueError naming the argument and its range [0, 5] K for a negative, too
+    large or non-finite deficit (a float, a tensor or an array per image), at construction and when set
+    later (a refused value is not kept); a list, or a tensor of more than one axis, is refused like time_s;
+    per image, its batch size joins the scene's."""
+    with pytest.raises(ValueError, match=r"^skin_deficit must lie in \[0, 5\] K"):
+        make_scene(skin_deficit=bad)
+    s = make_scene(skin_deficit=torch.tensor([0.0, 0.5]))
+    with pytest.raises(ValueError, match=r"^skin_deficit must lie in \[0, 5\] K"):
+        s.skin_deficit = bad
+    assert torch.equal(s.skin_deficit, torch.tensor([0.0, 0.5]))
+
+
+def test_skin_deficit_shapes_and_batch_size():
+    with pytest.raises(ValueError, match=r"^skin_deficit: give a float or a tensor of shape \(B,\)"):
+        make_scene(skin_deficit=[0.1, 0.2])
+    with pytest.raises(ValueError, match=r"^skin_deficit: must be a float or a tensor of shape \(B,\)"):
+        make_scene(skin_deficit=torch.zeros(2, 2))
+    assert make_scene(skin_deficit=torch.tensor([0.1, 0.2, 0.3])).batch_size == 3
+    with pytest.raises(ValueError, match=r"wind_speed has 2, skin_deficit has 3"):
+        make_scene(wind_speed=torch.tensor([5.0, 6.0]), skin_deficit=torch.tensor([0.1, 0.2, 0.3])).batch_size
 
 
 def test_a_sequence_of_seeds_needs_one_per_image():
