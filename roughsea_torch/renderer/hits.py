@@ -28,6 +28,11 @@ Method (the running horizon of height-field renderers, applied to the sea):
   1/cos θ̂ times longer along the view than across, the samples resolve the waves down to ``across``
   times its width across (:func:`sample_step`). Tracks run at azimuths ``1/tracks`` pixel apart; a
   pixel takes its nearest track.
+- The samples' finer footprints resolve waves that the pixel's own footprint does not, and the hits
+  weight those facets by their visible area, not by the expectation's Eq. 5 weight: their mean leaves
+  the expectation image. So the sweep's part fades out with the pixel's own footprint
+  (:func:`footprint_fade`), to exactly 0 where the pixel resolves no band: the far field is the
+  expectation image.
 
 Everything is differentiable in the wind (through η, the slopes and the crest variable) and the pose
 (through t and the pixels' depressions); the choice of samples and elements is not (indices are
