@@ -131,13 +131,14 @@ def _far_camera_renders(wind: float, **scene_kw):
 @pytest.mark.parametrize("wind, scene_kw", [(5.0, dict(foam=False)), (15.0, dict(foam=False)), (15.0, {}),
                                             (5.0, dict(foam=False, sun_zenith=math.radians(80.0), sun_azimuth=0.0))])
 def test_far_field_camera_of_the_sweep_is_the_expectation_image(wind, scene_kw):
-    """From a 20 m mast looking 2° down, the pixels whose own footprint resolves no wave (beyond ~400 m at
+    """From a 20 m mast looking 2° down, the pixels whose own footprint resolves no wave (beyond ~500 m at
     5 m/s) are the expectation image within 1e-3 K with the first hit, though the sweep's samples, filtered
     at 1/16 of that footprint there, still resolve waves: with foam (15 m/s, the scene's default) and
-    with a sun 10° above the horizon ahead (its glint) too. Planted, the sweep not fading out with the
-    pixel's own footprint (hits.footprint_fade ≡ 1, as before): 0.15, 0.12, 0.11 and 1.16 K off in the
-    four cases (the samples' visible-area weighting leans the mean: −0.09 K over 8 seeds at 88.4°, 5 m/s,
-    pipelines/first_hit_far_field.py); the foam covers not blended with the flat point's: 0.09 K."""
+    with a sun 10° above the horizon ahead (its glint) too (measured 4e-8 to 1.5e-6 K). Planted, the
+    sweep not fading out with the pixel's own footprint (hits.footprint_fade ≡ 1, as before): 0.15, 0.12,
+    0.11 and 1.16 K off in the four cases (the samples' visible-area weighting leans the mean: −0.09 K
+    over 8 seeds at 88.4°, 5 m/s, pipelines/first_hit_far_field.py); the foam covers not blended with the
+    flat point's: 0.09 K."""
     tex, mean, far = _far_camera_renders(wind, **scene_kw)
     assert int(far.sum()) >= 64
     assert float((tex - mean)[far].abs().max()) < 1e-3
