@@ -696,6 +696,8 @@ def main() -> None:
         with open(args.replot or args.retexture, "rb") as fh:
             saved = pickle.load(fh)
         cases, ens = (saved["cases"], saved["ens"]) if args.replot else retexture(saved)
+        if args.retexture:  # the identities are the renderer's: measured again with this checkout's TABLE
+            saved["ident"] = renderer_identities()
         Path(args.out).mkdir(parents=True, exist_ok=True)
         command = saved["command"] + (f" --texture-hit {args.texture_hit}" if suffix else "")
         if args.retexture:

@@ -28,6 +28,11 @@ Method (the running horizon of height-field renderers, applied to the sea):
   1/cos θ̂ times longer along the view than across, the samples resolve the waves down to ``across``
   times its width across (:func:`sample_step`). Tracks run at azimuths ``1/tracks`` pixel apart; a
   pixel takes its nearest track.
+- The samples' finer footprints resolve waves that the pixel's own footprint does not, and the hits
+  weight those facets by their visible area, not by the expectation's Eq. 5 weight: their mean leaves
+  the expectation image. So the sweep's part fades out with the pixel's own footprint
+  (:func:`footprint_fade`), to exactly 0 where the pixel resolves no band: the far field is the
+  expectation image.
 
 Everything is differentiable in the wind (through η, the slopes and the crest variable) and the pose
 (through t and the pixels' depressions); the choice of samples and elements is not (indices are
@@ -52,8 +57,10 @@ import numpy as np
 import torch
 
 from ..clutter import footprint
+from ..wave_bands import band_window
 
-__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "visible_samples", "flat_nonzero", "pixel_windows", "visible_average", "centre_element", "pixel_hits", "sample_step"]
+__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "visible_samples", "flat_nonzero", "pixel_windows", "visible_average",
+           "centre_element", "pixel_hits", "sample_step", "footprint_fade"]
 
 
 def sample_step(cos_view: Any, step: float, min_step: float, across: float) -> Any:
@@ -61,6 +68,24 @@ def sample_step(cos_view: Any, step: float, min_step: float, across: float) -> A
     ``across`` · cos θ̂ / 2 clamped into [``min_step``, ``step``] (a tensor or a numpy array)."""
     half = 0.5 * across * cos_view
     return half.clip(min_step, step) if hasattr(half, "clip") else min(max(half, min_step), step)
+
+
+def footprint_fade(field: Any, image: int, pixel_footprint: torch.Tensor) -> torch.Tensor:
+    """g, the weight of the swept texture at pixels whose own footprint (R δ / cos θ̂,
+    :func:`~roughsea_torch.clutter.footprint`) is ``pixel_footprint`` [m] (any shape): the window
+    (:func:`~roughsea_torch.wave_bands.band_window`) of the longest band the ``image`` -th image of the
+    field holds (nonzero slope variance), at that footprint. 1 while the pixel resolves that band fully,
+    falling (C¹) over the octave of footprint in which it stops resolving it, exactly 0 where it resolves
+    no band: there the sweep's samples, filtered at finer footprints, would still resolve waves, whose
+    visible-area weighting leans the mean away from the expectation image; a pixel takes g · the
+    sweep's texture, i.e. the expectation image where it resolves nothing (``docs/texture.md`` §11).
+    Differentiable in the footprint (the band's choice is not)."""
+    cov = field.band_covariance()[image]  # (n_bands, 3)
+    on = ((cov[:, 0] + cov[:, 1]).detach() > 0).tolist()
+    k = [kc for kc, o in zip(field.bands.band_wavenumber, on) if o]
+    if not k:
+        return torch.zeros_like(pixel_footprint)
+    return band_window(pixel_footprint, float(min(k)))
 
 
 @dataclass

@@ -28,7 +28,7 @@ from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
-from .hits import (Sweep, flat_nonzero, pixel_hits, pixel_windows, sample_step, sweep_envelope, sweep_layout,
+from .hits import (Sweep, flat_nonzero, footprint_fade, pixel_hits, pixel_windows, sample_step, sweep_envelope, sweep_layout,
                    visible_samples)
 from .path import path_rows
 from .scene import SceneParameters
@@ -267,7 +267,7 @@ class TextureTable:
         sees the visible surface of its depression window along its ground track
         (:mod:`~roughsea_torch.renderer.hits`); with ``"flat"`` its flat-sea point."""
         if self.first_hit:
-            return self._pixels_swept(sl, vol, dz, dx, dy, sea, lo, span_z, a, b, coordinate, crest)
+            return self._pixels_swept(sl, vol, cos_t, dz, dx, dy, sea, lo, span_z, a, b, coordinate, crest)
         wf = self.field(sl)
         dtype = self.dtype
         h = self.altitude[sl].to(dtype)[:, None, None]
@@ -299,39 +299,75 @@ class TextureTable:
         return (out, x if vol.shape[1] == 1 else (x, read[:, 1]),
                 (cov[:, 0], cov[:, 1], cov[:, 2]), f_pix)
 
-    def _pixels_swept(self, sl: slice, vol: torch.Tensor, dz: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor,
-                      sea: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor,
-                      coordinate: Any, crest: bool) -> tuple:
+    def _pixels_swept(self, sl: slice, vol: torch.Tensor, cos_t: torch.Tensor, dz: torch.Tensor, dx: torch.Tensor,
+                      dy: torch.Tensor, sea: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor,
+                      b: torch.Tensor, coordinate: Any, crest: bool) -> tuple:
         """:meth:`pixels` by the sweep: per image, the resolved surface along ground tracks, the texture
         and foam fraction at each sample, each pixel's angular average over the visible surface of its
-        window; for the glint, x and the covariance at its centre ray's first hit."""
+        window; for the glint, x and the covariance at its centre ray's first hit. The texture, the
+        resolved covariance and the foam covers fade out with the pixel's own footprint
+        (:func:`footprint_fade` g: the texture g · the sweep's, the covariance g² · the hit's, the covers
+        g · the sweep's + (1 − g) · the flat point's), so where the pixel resolves no band it is the flat
+        point's, i.e. the expectation image."""
         zero = torch.zeros_like(dz)
         texture, x_c, f_pix = zero.clone(), zero.clone(), (zero.clone(), zero.clone()) if crest else None
         cov_c = [zero.clone() for _ in range(3)]
+        h = self.altitude[sl].to(self.dtype)
         for i in range(dz.shape[0]):
             s = sea[i]
             if not bool(s.any()):
                 continue
-            rho = torch.sqrt(dx[i] * dx[i] + dy[i] * dy[i]).clamp_min(1e-30)
-            tan_g, phi = (-dz[i] / rho)[s], torch.atan2(dy[i], dx[i])[s]
             im = sl.start + i
             wf = self.field(slice(im, im + 1))
-            sw = sweep_layout(wf, 0, self.centres[im], self.altitude[im], tan_g, phi, float(self.ifov[im]),
-                              self.earth_radius_m, tracks=self.hit_tracks, **self.hit_steps)
+            R = slant_range(cos_t[i][s], h[i], self.earth_radius_m)
+            L = footprint(R, cos_t[i][s], self.ifov[im])
+            g = footprint_fade(wf, 0, L)
+            rho = torch.sqrt(dx[i] * dx[i] + dy[i] * dy[i]).clamp_min(1e-30)
+            tan_g, phi = (-dz[i] / rho)[s], torch.atan2(dy[i], dx[i])[s]
+            sw = None
+            if bool((g.detach() > 0).any()):  # (else no pixel resolves a band: the expectation image)
+                sw = sweep_layout(wf, 0, self.centres[im], self.altitude[im], tan_g, phi, float(self.ifov[im]),
+                                  self.earth_radius_m, tracks=self.hit_tracks, **self.hit_steps)
+            if sw is None:
+                g = torch.zeros_like(g)
+            flat = self._flat_covers(im, wf, R, L, dx[i][s], dy[i][s], g) if crest else None
+            if crest:
+                for c in range(2):
+                    f_pix[c][i] = f_pix[c][i].index_put((s,), flat[c])
             if sw is None:
                 continue
             values, x_k, cov_k, m = self._swept_samples(im, i, wf, sw, vol, lo, span_z, a, b, coordinate, crest)
             j = ((phi.detach() - sw.p0) / sw.dphi).round().clamp(0, sw.az.shape[0] - 1).long()
             tau_t, tau_b = pixel_windows(tan_g, float(self.ifov[im]))
             avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g)
-            texture[i] = texture[i].index_put((s,), avg[0])
+            texture[i] = texture[i].index_put((s,), g * avg[0])
             if crest:  # the active and residual covers
                 for c in range(2):
-                    f_pix[c][i] = f_pix[c][i].index_put((s,), avg[1 + c])
+                    f_pix[c][i] = f_pix[c][i].index_put((s,), flat[c] + g * avg[1 + c])
             x_c[i] = x_c[i].index_put((s,), torch.where(hit, x_k[j, k], torch.zeros_like(tan_g)))
-            for c in range(3):
-                cov_c[c][i] = cov_c[c][i].index_put((s,), cov_k[c][k])
+            for c in range(3):  # (g² C: the glint's resolved part fades with the texture)
+                cov_c[c][i] = cov_c[c][i].index_put((s,), g * g * cov_k[c][k])
         return texture, (x_c, x_c), tuple(cov_c), f_pix
+
+    def _flat_covers(self, im: int, wf: Any, R: torch.Tensor, L: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor,
+                     g: torch.Tensor) -> list[torch.Tensor]:
+        """(1 − g) · the foam covers (f_act, f_res) of pixels of image ``im`` at their flat-sea points, as
+        :meth:`pixels` takes them with ``texture_hit="flat"`` (without its column filter), each (P,):
+        slant ranges ``R``, footprints ``L``, ray directions ``dx``, ``dy`` and the sweep's weights ``g``
+        (P,); evaluated only where g < 1."""
+        out = [torch.zeros_like(g), torch.zeros_like(g)]
+        need = flat_nonzero(g.detach() < 1.0)
+        if need.numel() == 0:
+            return out
+        pick = lambda v: v.index_select(0, need)  # noqa: E731
+        Rn, Ln, t_s = pick(R), pick(L)[None], self.time[im:im + 1]
+        X = (self.centres[im, 0] + Rn * pick(dx))[None]
+        Y = (self.centres[im, 1] + Rn * pick(dy))[None]
+        crest = wf.sample_unchecked(X, Y, t_s, Ln, elevation=False, crest=True, slopes=False)["crest"]
+        covers = whitecap_cover(wf, X, Y, t_s, Ln, crest, wf.crest_variance(Ln), wf.crest_variance()[:, None],
+                                self.p.foam[im:im + 1].to(self.dtype)[:, None], trails=self.foam_trails)
+        w = 1.0 - pick(g)
+        return [o.index_put((need,), w * f[0]) for o, f in zip(out, covers)]
 
     def _swept_samples(self, im: int, i: int, wf: Any, sw: Sweep, vol: torch.Tensor, lo: torch.Tensor,
                        span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any, crest: bool) -> tuple:
