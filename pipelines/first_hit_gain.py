@@ -12,10 +12,12 @@ F_s vary from ray to ray and the pixel averages the model over them (unresolved 
 
 The two agree if the model were a Gaussian convolution of one facet response (then splitting the
 slopes at any scale gives the same function of a); it is not: Eq. 5's shadowing and the facet weight
-depend on the unresolved covariance. The script prints their slopes dE/da at a = 0 (K per unit slope)
-and the σ they give a resolved slope of the bin's rms (σ_a of the bands the sweep resolves),
-E over a ~ N(0, σ_a²); the ratio is what the sweep keeps of the clutter at that scale, whatever its
-sampling.
+depend on the unresolved covariance. The script prints their slopes dE/da at a = 0 (K per unit slope),
+the σ they give a resolved slope of the bin's rms (σ_a of the bands the sweep resolves) over
+a ~ N(0, σ_a²), their regression slopes on a over that distribution (E[dE/da], Stein's lemma), and
+E_T's regression slope with each sub-footprint facet weighted by its projected area
+(cos θ̂ + sin θ̂ t)₊ instead of uniformly (how uniform points of the image plane sample facets; the
+hiding by crests in front left out). The ray tracer's first hits lie between the two weightings.
 
 Usage:
     python pipelines/first_hit_gain.py [--wind 5 10 15] [--direction upwind crosswind]
@@ -70,8 +72,9 @@ def main() -> None:
     gh_x, gh_w = np.polynomial.hermite_e.hermegauss(16)  # E over N(0, 1)
     gh_w = gh_w / gh_w.sum()
     print("| case | view zenith [°] | F_s [m] | σ_a res | σ_a sub-pixel traced | dE/da sweep [K] | dE/da ray [K] | "
-          "σ sweep [K] | σ ray [K] | ratio | E[dE/da] sweep [K] | E[dE/da] ray [K] | ratio |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+          "σ sweep [K] | σ ray [K] | ratio | E[dE/da] sweep [K] | E[dE/da] ray [K] | ratio | "
+          "E[dE/da] ray, facets by projected area [K] | ratio |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for direction in args.direction:
         mast, wdir = DIRECTIONS[direction]
         for wind in args.wind:
@@ -131,8 +134,16 @@ def main() -> None:
                 P = kap * a_grid[:, None, None] + math.sqrt(max(var_sub_p, 0)) * torch.tensor(gh_x, dtype=f64)[None, None, :]
                 A, P = torch.broadcast_tensors(A, P)
                 wts = torch.tensor(np.outer(gh_w, gh_w), dtype=f64)
-                Lr = (radiance(A.reshape(-1), P.reshape(-1), u_ray).reshape(A.shape) * wts).sum((1, 2))
+                Lr_all = radiance(A.reshape(-1), P.reshape(-1), u_ray).reshape(A.shape)
+                Lr = (Lr_all * wts).sum((1, 2))
+                # the same, each traced facet weighted by its projected area seen from the camera,
+                # (cos θ̂ + sin θ̂ t)₊ with t its along-view slope (facets turned away are not hit): how
+                # uniform points of the image plane sample the facets (hiding by other crests left out)
+                vis = (math.cos(vz) + math.sin(vz) * A).clamp_min(0.0) * wts
+                vsum = vis.sum((1, 2))
+                Lv = torch.where(vsum > 0, (Lr_all * vis).sum((1, 2)) / vsum.clamp_min(1e-300), Lr)  # (none seen: any)
                 Ts, Tr = brightness_temperature(Ls, LWIR), brightness_temperature(Lr, LWIR)
+                Tv = brightness_temperature(Lv, LWIR)
                 g_s = float(Ts[1] - Ts[0]) / 2e-3
                 g_r = float(Tr[1] - Tr[0]) / 2e-3
                 w = torch.tensor(gh_w, dtype=f64)
@@ -143,7 +154,8 @@ def main() -> None:
                 reg = lambda T: float((T[2:] * a_grid[2:] * w).sum()) / var_a  # noqa: E731
                 print(f"| {direction} {wind:g} m/s | {math.degrees(vz):.1f} | {Fs:.2f} | {math.sqrt(var_a):.3f} | "
                       f"{math.sqrt(max(var_sub_a, 0)):.3f} | {g_s:.2f} | {g_r:.2f} | {sd(Ts):.3f} | {sd(Tr):.3f} | "
-                      f"{sd(Ts) / sd(Tr):.2f} | {reg(Ts):.2f} | {reg(Tr):.2f} | {reg(Ts) / reg(Tr):.2f} |")
+                      f"{sd(Ts) / sd(Tr):.2f} | {reg(Ts):.2f} | {reg(Tr):.2f} | {reg(Ts) / reg(Tr):.2f} | "
+                      f"{reg(Tv):.2f} | {reg(Ts) / reg(Tv):.2f} |")
 
 
 def _along_part(res, e, ep, phi, wdir):
