@@ -19,6 +19,7 @@ rays (the hits' own distribution of a, which the first hit weights):
 
 Usage:
     python pipelines/first_hit_response.py [--rays 16] [--cases upwind:5:8,16,24,32 crosswind:10:0,8]
+        [--across 0.5 --min-step 0.0078125]   # the sample footprint of other sweep settings
 """
 
 from __future__ import annotations
@@ -57,7 +58,7 @@ def to_slope_frame(vx, vy, cxy, wdir: float):
             (vy - vx) * c * s + cxy * (c * c - s * s))
 
 
-def response(direction: str, wind: float, row0: int, rays: int) -> dict:
+def response(direction: str, wind: float, row0: int, rays: int, across: float = 1.0, min_step: float = 1 / 32) -> dict:
     f64 = torch.float64
     mast, wdir = DIRECTIONS[direction]
     cams = rs.make_camera(H, W, hfov_deg=HFOV, altitude_m=mast, pitch_deg=PITCH)
@@ -88,7 +89,7 @@ def response(direction: str, wind: float, row0: int, rays: int) -> dict:
     # the slope the sweep resolves at the hit: the field at its sample footprint
     rng = tr["flat_range_m"][0][hit]
     delta = 2.0 * math.tan(math.radians(HFOV / 2)) / W
-    fs = 2.0 * sample_step(cz, 0.25, 1 / 32, 1.0) * rng * delta / cz
+    fs = 2.0 * sample_step(cz, 0.25, min_step, across) * rng * delta / cz
     smp = field.sample(x[None], y[None], TIME_S, footprint=fs[None])
     ex, ey = torch.cos(vaw), torch.sin(vaw)
     a = smp["slope_x"][0] * ex + smp["slope_y"][0] * ey
@@ -99,30 +100,66 @@ def response(direction: str, wind: float, row0: int, rays: int) -> dict:
     # the sweep's sample at a: unresolved_statistics in the slope frame (its along-view σ_a², κ)
     sweep_stats = unresolved_statistics(torch.full_like(a, tot[0]), torch.full_like(a, tot[1]), torch.full_like(a, tot[2]),
                                         los, var_a, kap, a)
-    T_sweep = brightness_temperature(apparent_radiance(vz, los, sweep_stats, m, rb, sky, quadrature=QUAD), LWIR)
+    L_sweep = apparent_radiance(vz, los, sweep_stats, m, rb, sky, quadrature=QUAD)
+    T_sweep = brightness_temperature(L_sweep, LWIR)
+    pix = pixel_level(tr, hit, T_ray, T_sweep)
     ac = a - a.mean()
     beta = lambda T: float(((T - T.mean()) * ac).mean() / (ac * ac).mean())  # noqa: E731
     r = float(((T_ray - T_ray.mean()) * ac).mean() / math.sqrt(float(T_ray.var(correction=0) * (ac * ac).mean())))
     return dict(vz=(math.degrees(float(vz.min())), math.degrees(float(vz.max()))), fs=float(fs.mean()),
-                sigma_a=float(ac.std()), beta_ray=beta(T_ray), beta_sweep=beta(T_sweep), r=r, n=int(hit.sum()))
+                sigma_a=float(ac.std()), beta_ray=beta(T_ray), beta_sweep=beta(T_sweep), r=r, n=int(hit.sum()), **pix)
+
+
+def pixel_level(tr: dict, hit: torch.Tensor, T_ray: torch.Tensor, T_sweep: torch.Tensor) -> dict:
+    """The same rays made into pixels: each pixel the mean over its rays of (a) the ray tracer's
+    temperature and (b) the sweep's model at the slope resolved at F_s at each hit — the ray tracer's
+    geometry with the sweep's node values. σ of (b) / σ of (a) about the row means (each with its
+    sampling variance over rays removed), per pixel and after 4×4 blocks, and the regression gain of (b)
+    on (a) at both scales. (b) ≈ (a) in σ: the node values are not the cause; (b) ≈ the textured
+    image's 0.8: they are."""
+    h, w, S = tr["hit"][0].shape
+    if int(hit.sum()) != h * w * S:
+        return dict(ratio_pix=math.nan, ratio_blk=math.nan, gain_pix=math.nan, gain_blk=math.nan)
+    a = T_ray.reshape(h, w, S)
+    b = T_sweep.reshape(h, w, S)
+    out = {}
+    for name, n in (("pix", 1), ("blk", 4)):
+        am = a.mean(-1).reshape(h // n, n, w // n, n).mean((1, 3))
+        bm = b.mean(-1).reshape(h // n, n, w // n, n).mean((1, 3))
+        # sampling variance of a block mean: the pixels' variances over rays / S, averaged over n² pixels / n²
+        na = (a.var(-1) / S).reshape(h // n, n, w // n, n).mean((1, 3)) / (n * n)
+        nb = (b.var(-1) / S).reshape(h // n, n, w // n, n).mean((1, 3)) / (n * n)
+        nab = (((a - a.mean(-1, keepdim=True)) * (b - b.mean(-1, keepdim=True))).sum(-1) / (S - 1) / S
+               ).reshape(h // n, n, w // n, n).mean((1, 3)) / (n * n)
+        ac_, bc_ = am - am.mean(1, keepdim=True), bm - bm.mean(1, keepdim=True)
+        shrink = 1 - 1 / am.shape[1]
+        va = float((ac_ * ac_).mean() - na.mean() * shrink)
+        vb = float((bc_ * bc_).mean() - nb.mean() * shrink)
+        cab = float((ac_ * bc_).mean() - nab.mean() * shrink)
+        out[f"ratio_{name}"] = math.sqrt(max(vb, 0.0) / va) if va > 0 else math.nan
+        out[f"gain_{name}"] = cab / va if va > 0 else math.nan
+    return out
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rays", type=int, default=16)
+    ap.add_argument("--across", type=float, default=1.0, help="the sweep's texture_hit_across (its footprint)")
+    ap.add_argument("--min-step", type=float, default=1 / 32, help="the sweep's texture_hit_min_step")
     ap.add_argument("--cases", nargs="+", default=list(DEFAULT_CASES), metavar="DIR:WIND:ROW,ROW")
     args = ap.parse_args()
     torch.set_num_threads(1)
     print("| case | view zenith [°] | F_s [m] | σ_a at the hits | β ray [K] | β sweep [K] | β sweep / β ray | "
-          "r(T ray, a) | rays |")
-    print("|---|---|---:|---:|---:|---:|---:|---:|---:|")
+          "r(T ray, a) | rays | pixels: σ (b)/(a) | gain | 4×4: σ (b)/(a) | gain |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for case in args.cases:
         direction, wind, rows = case.split(":")
         for row0 in (int(v) for v in rows.split(",")):
-            d = response(direction, float(wind), row0, args.rays)
+            d = response(direction, float(wind), row0, args.rays, args.across, args.min_step)
             print(f"| {direction} {float(wind):g} m/s | {d['vz'][0]:.1f}–{d['vz'][1]:.1f} | {d['fs']:.2f} | "
                   f"{d['sigma_a']:.3f} | {d['beta_ray']:.2f} | {d['beta_sweep']:.2f} | "
-                  f"{d['beta_sweep'] / d['beta_ray']:.2f} | {d['r']:.2f} | {d['n']} |", flush=True)
+                  f"{d['beta_sweep'] / d['beta_ray']:.2f} | {d['r']:.2f} | {d['n']} | {d['ratio_pix']:.2f} | "
+                  f"{d['gain_pix']:.2f} | {d['ratio_blk']:.2f} | {d['gain_blk']:.2f} |", flush=True)
 
 
 if __name__ == "__main__":
