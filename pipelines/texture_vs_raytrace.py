@@ -29,6 +29,8 @@ turns the vertical by 0.007°).
 Usage:
     python pipelines/texture_vs_raytrace.py [--quick | --full] [--out docs] [--save results.pkl]
     python pipelines/texture_vs_raytrace.py --replot results.pkl   # report and figures again, no tracing
+    python pipelines/texture_vs_raytrace.py --retexture results.pkl --texture-hit first --hit-across 2 \
+        --cases upwind:5:-6 crosswind:*:-6   # the textured side again with other sweep settings, some cases
 
 Defaults: 64 rays per pixel for the 12 cases, an ensemble of 16 seeds at 4 rays per pixel, the specular
 check at 64 rays per pixel on the two 10 m/s upwind cases, one torch thread (``--threads``); the report
@@ -77,6 +79,23 @@ def scene(wind: float, direction: float, seed, *, sky="midlatitude_summer") -> r
 
 
 TABLE = rs.TableSize()  # the renderer's settings; --texture-hit chooses where pixels meet the resolved waves
+
+
+# --hit-* options: the sweep's settings of texture_hit="first" (TableSize fields, hits.sample_step)
+HIT_OPTIONS = (("--hit-step", "texture_hit_step", "largest sample spacing in depression [px]"),
+               ("--hit-min-step", "texture_hit_min_step", "smallest sample spacing [px]"),
+               ("--hit-across", "texture_hit_across", "spacing across * cos(view zenith) / 2 [px]"),
+               ("--hit-tracks", "texture_hit_tracks", "ground tracks per pixel width"))
+
+
+def selected(case: dict, patterns: list[str]) -> bool:
+    """Whether a case (direction, wind, pitch) matches one of the DIR:WIND:PITCH patterns ('*': any)."""
+    for pat in patterns:
+        parts = (pat.split(":") + ["*", "*"])[:3]
+        if all(p == "*" or (p == case["direction"] if i == 0 else float(p) == float(case[("wind", "pitch")[i - 1]]))
+               for i, p in enumerate(parts)):
+            return True
+    return False
 
 
 def render(cams, sc) -> torch.Tensor:
@@ -363,6 +382,8 @@ def criteria(cases: list[dict], ens: list[dict]) -> list[str]:
     ok_mean = sum(1 for b in esel if abs(b["diff"]) <= 0.05)
     eratio = [b["ratio"] for b in esel if math.isfinite(b["ratio"])]
     ok_esigma = sum(1 for r in eratio if 0.85 <= r <= 1.2)
+    if not sel or not esel:
+        return [f"{len(every)} bins lie at 80–88.5° in the cases run; the criteria need some of them."]
     ratios = [b["ratio"] for _, b in sel]
     lens = [b["len_tex"] / b["len_ray"] for _, b in sel if math.isfinite(b["len_tex"] / b["len_ray"])]
     return [
@@ -479,7 +500,8 @@ def reading(cases: list[dict], ens: list[dict], spec: list[dict]) -> list[str]:
 
 def report(args, cases, ens, spec, ident, timings, command, date) -> str:
     hit = getattr(args, "texture_hit", "flat")
-    sfx = "" if hit == rs.TableSize().texture_hit else f"_{hit}"
+    sfx = getattr(args, "suffix", "" if hit == rs.TableSize().texture_hit else f"_{hit}")
+    sweep = "".join(f", {field}={v:g}" for field, v in getattr(args, "hit_settings", {}).items())
     lines = [
         "# Textured renders against a brute-force ray tracer of the same realization",
         "",
@@ -492,7 +514,7 @@ def report(args, cases, ens, spec, ident, timings, command, date) -> str:
         "path=False)`, LWIR 8–12 µm, LOWTRAN7 midlatitude-summer sky, anisotropic Cox–Munk; cameras 48×64 px over 12°, "
         "yaw 0, looking upwind (wind direction 0, 15 m mast) or crosswind (wind direction π/2, 20 m mast), pitch −6° "
         "and −16°; flat sea in both renderers. Textured: `rs.render(..., output='brightness_temperature', "
-        f"table=rs.TableSize(texture_hit={hit!r}))` ({'the flat-sea point' if hit == 'flat' else 'the sweep along ground tracks'}). "
+        f"table=rs.TableSize(texture_hit={hit!r}{sweep}))` ({'the flat-sea point' if hit == 'flat' else 'the sweep along ground tracks'}). "
         f"Ray-traced: `roughsea_torch.raytrace.raytraced_image`, {args.rays} rays per pixel through i.i.d. points of "
         "the pixel, first hits on the field's bands with k ≤ 64 rad/m (Lipschitz march, bisection to 1e-7 m), the "
         "remaining slope covariance (Cox–Munk minus the traced bands') averaged by the model about the traced slope.",
@@ -687,22 +709,37 @@ def main() -> None:
                     help="a pickle of --save: render its textured side again with this checkout (no tracing)")
     ap.add_argument("--texture-hit", choices=("flat", "first"), default=rs.TableSize().texture_hit,
                     help="TableSize.texture_hit of the textured renders (default: the renderer's)")
+    for flag, field, what in HIT_OPTIONS:
+        ap.add_argument(flag, type=float, default=None,
+                        help=f"TableSize.{field} of the textured renders ({what}; default: the renderer's)")
+    ap.add_argument("--cases", nargs="+", default=None, metavar="DIR:WIND:PITCH",
+                    help="only these cases, e.g. upwind:5:-6 crosswind:*:-6 ('*' matches any; default: all)")
     args = ap.parse_args()
     torch.set_num_threads(max(1, args.threads))
     global TABLE
-    TABLE = rs.TableSize(texture_hit=args.texture_hit)
+    hit = {field: getattr(args, flag[2:].replace("-", "_")) for flag, field, _ in HIT_OPTIONS}
+    hit = {k: v for k, v in hit.items() if v is not None}
+    TABLE = rs.TableSize(texture_hit=args.texture_hit, **hit)
     suffix = "" if args.texture_hit == rs.TableSize().texture_hit else f"_{args.texture_hit}"
+    suffix += "".join(f"_{flag[6:]}{v:g}" for flag, field, _ in HIT_OPTIONS if (v := hit.get(field)) is not None)
+    suffix += "_cases" if args.cases else ""
     if args.replot or args.retexture:
         with open(args.replot or args.retexture, "rb") as fh:
             saved = pickle.load(fh)
+        if args.cases:
+            saved = dict(saved, cases=[c for c in saved["cases"] if selected(c, args.cases)],
+                         ens=[e for e in saved["ens"] if selected(e, args.cases)])
         cases, ens = (saved["cases"], saved["ens"]) if args.replot else retexture(saved)
         if args.retexture:  # the identities are the renderer's: measured again with this checkout's TABLE
             saved["ident"] = renderer_identities()
         Path(args.out).mkdir(parents=True, exist_ok=True)
-        command = saved["command"] + (f" --texture-hit {args.texture_hit}" if suffix else "")
+        command = saved["command"] + (f" --texture-hit {args.texture_hit}" if args.texture_hit != "flat" else "")
+        command += "".join(f" {flag} {v:g}" for flag, field, _ in HIT_OPTIONS if (v := hit.get(field)) is not None)
+        command += f" --cases {' '.join(args.cases)}" if args.cases else ""
         if args.retexture:
             command += f"  (textured side again: --retexture, {dt.date.today().isoformat()})"
         saved["args"].texture_hit = args.texture_hit
+        saved["args"].suffix, saved["args"].hit_settings = suffix, hit
         if not hasattr(saved["args"], "threads"):  # a pickle of an earlier version
             saved["args"].threads = torch.get_num_threads()
         figures(Path(args.out), cases, ens, suffix)
@@ -710,7 +747,7 @@ def main() -> None:
                                                                         saved["ident"], saved["timings"], command,
                                                                         saved["date"]))
         return
-    args.texture_hit = args.texture_hit
+    args.suffix, args.hit_settings = suffix, hit
     winds = (5.0, 15.0) if args.quick else (5.0, 10.0, 15.0)
     args.rays = 16 if args.quick else 128 if args.full else 64
     args.seeds = list(range(100, 102 if args.quick else (132 if args.full else 116)))
@@ -721,9 +758,13 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
     load_start = os.getloadavg()[0]
     command = ("python pipelines/texture_vs_raytrace.py" + (" --quick" if args.quick else " --full" if args.full else "")
-               + (f" --texture-hit {args.texture_hit}" if suffix else ""))
+               + (f" --texture-hit {args.texture_hit}" if args.texture_hit != rs.TableSize().texture_hit else "")
+               + "".join(f" {flag} {v:g}" for flag, field, _ in HIT_OPTIONS if (v := hit.get(field)) is not None)
+               + (f" --cases {' '.join(args.cases)}" if args.cases else ""))
 
-    combos = [(d, w, p) for d in DIRECTIONS for w in winds for p in PITCHES]
+    combos = [(d, w, p) for d in DIRECTIONS for w in winds for p in PITCHES
+              if not args.cases or selected(dict(direction=d, wind=w, pitch=p), args.cases)]
+    spec_cases = [(w, p) for w, p in spec_cases if ("upwind", w, p) in combos]  # (the cases it checks must run)
     total = H * len(combos) * (1 + len(args.seeds)) + H * len(spec_cases)
     cases, ens, spec, timings = [], [], [], []
     with tqdm(total=total, unit="row", desc="ray-traced rows") as bar:
