@@ -70,7 +70,7 @@ def stages(cams, textured) -> list[tuple[str, float]]:
     """Self time of the textured render's main parts (1 thread, torch profiler's CPU totals)."""
     from torch.profiler import ProfilerActivity, profile, record_function
 
-    import roughsea_torch.clutter as cl
+    import roughsea_torch.renderer.texture as cl
 
     wrapped = {}
     for name in ("node_values", "volume", "pixels"):
