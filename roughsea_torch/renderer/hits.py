@@ -59,7 +59,7 @@ import torch
 from ..clutter import footprint
 from ..wave_bands import band_window
 
-__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "visible_samples", "flat_nonzero", "pixel_windows", "visible_average",
+__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "covers", "visible_samples", "flat_nonzero", "pixel_windows", "visible_average",
            "centre_element", "pixel_hits", "sample_step", "footprint_fade"]
 
 
@@ -92,7 +92,9 @@ def footprint_fade(field: Any, image: int, pixel_footprint: torch.Tensor) -> tor
 class Sweep:
     """One image's sweep: sample distances ``r`` (ns,) [m] and track azimuths ``az`` (nt,) [rad], the
     points (``x``, ``y``: (ns, nt) world [m]) and their footprints ``footprint`` (ns,) [m]; the camera's
-    height ``h`` [m] and the curvature term ``curv`` = 1/(2R) [m⁻¹]."""
+    height ``h`` [m] and the curvature term ``curv`` = 1/(2R) [m⁻¹]; the first track's azimuth ``p0``
+    and the tracks' spacing ``dphi`` [rad]; ``eta_max`` [m], the bound of the resolved elevation
+    :func:`sweep_layout` assumed (:meth:`until`)."""
 
     r: torch.Tensor
     az: torch.Tensor
@@ -103,6 +105,7 @@ class Sweep:
     curv: float
     p0: float
     dphi: float
+    eta_max: float = 0.0
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -111,6 +114,23 @@ class Sweep:
     def flat_depression(self) -> torch.Tensor:
         """t0 (ns,): the depression of the flat sea's point at each sample."""
         return (self.h + self.curv * self.r * self.r) / self.r
+
+    def until(self, tau: float) -> "Sweep":
+        """The sweep's first samples (the same points), up to the first whose depression is ≤ ``tau`` (a
+        tangent) for any surface within ±``eta_max``: (h + η_max + r²/(2R))/r ≤ τ. A ray of depression
+        τ' ≥ τ first meets that surface at or before it, so every pixel whose window's upper edge is at
+        least τ reads the same elements of the shorter sweep as of the whole one (its running minimum
+        along a track depends only on the samples before; :func:`covers` checks it after the fact). The
+        whole sweep where no sample qualifies."""
+        ns = self.r.shape[0]
+        r = self.r.detach()
+        t_hi = (float(self.h.detach()) + self.eta_max + self.curv * r * r) / r
+        k = flat_nonzero(t_hi <= tau)
+        if k.numel() == 0 or int(k[0]) >= ns - 1:
+            return self
+        n = max(int(k[0]) + 1, 2)
+        return Sweep(self.r[:n], self.az, self.x[:n], self.y[:n], self.footprint[:n], self.h, self.curv, self.p0,
+                     self.dphi, self.eta_max)
 
 
 def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, tan_g: torch.Tensor, phi: torch.Tensor,
@@ -163,7 +183,7 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     rho = torch.sqrt(r * r + hf * hf)
     scale = 2.0 * torch.as_tensor(sample_step(np.sin(gam), step, min_step, across), dtype=dtype, device=device)
     fp = footprint(rho, hf / rho, ifov * scale)
-    return Sweep(r, az, x, y, fp, h.to(dtype), curv, p0, dphi)
+    return Sweep(r, az, x, y, fp, h.to(dtype), curv, p0, dphi, eta_max)
 
 
 def sweep_envelope(sweep: Sweep, eta: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
@@ -173,6 +193,13 @@ def sweep_envelope(sweep: Sweep, eta: torch.Tensor) -> tuple[torch.Tensor, torch
     t = ((sweep.h + sweep.curv * r * r)[:, None] - eta) / r[:, None]
     t = t.T.contiguous()
     return t, torch.cummin(t.detach(), dim=1).values
+
+
+def covers(m: torch.Tensor, j: torch.Tensor, tau_top: torch.Tensor) -> bool:
+    """Whether the running minimum m (nt, ns) of a sweep reaches, on each pixel's track ``j`` (P,), the
+    depression of its window's upper edge ``tau_top`` (P,) by its last sample: then the pixel's window
+    ends within the sweep, and more samples beyond would not change what it sees."""
+    return bool((m[:, -1].index_select(0, j) <= tau_top.detach()).all())
 
 
 def visible_samples(m: torch.Tensor, dim: int = -1) -> torch.Tensor:
