@@ -59,7 +59,7 @@ import torch
 from ..clutter import footprint
 from ..wave_bands import band_window
 
-__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "covers", "visible_samples", "flat_nonzero", "pixel_windows", "visible_average",
+__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "track_windows", "covers", "visible_samples", "flat_nonzero", "pixel_windows", "visible_average",
            "centre_element", "pixel_hits", "sample_step", "footprint_fade"]
 
 
@@ -195,6 +195,14 @@ def sweep_envelope(sweep: Sweep, eta: torch.Tensor) -> tuple[torch.Tensor, torch
     return t, torch.cummin(t.detach(), dim=1).values
 
 
+def track_windows(nt: int, j: torch.Tensor, tau_top: torch.Tensor, tau_bottom: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """(lo, hi), each (nt,): the least upper edge and the largest lower edge (depressions, tangents) of the
+    windows of the pixels on each track (``j`` (P,) their tracks); +inf and −inf on tracks without any."""
+    lo = torch.full((nt,), math.inf, dtype=tau_top.dtype, device=tau_top.device)
+    hi = torch.full((nt,), -math.inf, dtype=tau_top.dtype, device=tau_top.device)
+    return (lo.scatter_reduce(0, j, tau_top.detach(), "amin"), hi.scatter_reduce(0, j, tau_bottom.detach(), "amax"))
+
+
 def covers(m: torch.Tensor, j: torch.Tensor, tau_top: torch.Tensor) -> bool:
     """Whether the running minimum m (nt, ns) of a sweep reaches, on each pixel's track ``j`` (P,), the
     depression of its window's upper edge ``tau_top`` (P,) by its last sample: then the pixel's window
@@ -202,12 +210,21 @@ def covers(m: torch.Tensor, j: torch.Tensor, tau_top: torch.Tensor) -> bool:
     return bool((m[:, -1].index_select(0, j) <= tau_top.detach()).all())
 
 
-def visible_samples(m: torch.Tensor, dim: int = -1) -> torch.Tensor:
+def visible_samples(m: torch.Tensor, dim: int = -1, window: tuple[torch.Tensor, torch.Tensor] | None = None) -> torch.Tensor:
     """The samples that bound a visible element (m[k] > m[k + 1] on either side along ``dim``, the samples'
     axis: -1 for m (nt, ns), 0 for its transpose), the only ones :func:`visible_average` and
-    :func:`centre_element` read (a hidden element spans no depression); bool of m's shape, contiguous."""
+    :func:`centre_element` read (a hidden element spans no depression); bool of m's shape, contiguous.
+
+    ``window`` = (lo, hi), each track's depressions (tangents) that its pixels' windows span (broadcasting
+    against m along the tracks' axis, e.g. (nt, 1) for m (nt, ns)): only the visible elements whose
+    depressions [m[k + 1], m[k]] meet [lo, hi]. The others lie before every window of their track or
+    beyond it: they enter a pixel's average only through the cumulative sum's part before its window,
+    which cancels (their values may be anything finite, e.g. 0, at float rounding)."""
     n = m.shape[dim]
-    span = m.narrow(dim, 0, n - 1) > m.narrow(dim, 1, n - 1)
+    near, far = m.narrow(dim, 0, n - 1), m.narrow(dim, 1, n - 1)
+    span = near > far
+    if window is not None:
+        span &= (far <= window[1]) & (near >= window[0])
     vis = torch.zeros(m.shape, dtype=torch.bool, device=m.device)
     vis.narrow(dim, 0, n - 1).copy_(span)
     vis.narrow(dim, 1, n - 1).logical_or_(span)

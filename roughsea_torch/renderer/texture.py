@@ -29,7 +29,7 @@ from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
 from .hits import (Sweep, covers, flat_nonzero, footprint_fade, pixel_hits, pixel_windows, sample_step, sweep_envelope,
-                   sweep_layout, visible_samples)
+                   sweep_layout, track_windows, visible_samples)
 from .path import path_rows
 from .scene import SceneParameters
 from .sky_terms import sky_per_image
@@ -339,7 +339,9 @@ class TextureTable:
             tau_t, tau_b = pixel_windows(tan_g, float(self.ifov[im]))
             j = ((phi.detach() - sw.p0) / sw.dphi).round().clamp(0, sw.az.shape[0] - 1).long()
             sw, m = self._swept_envelope(im, wf, sw, j, tau_t, g)
-            values, x_k, cov_k = self._swept_samples(im, i, wf, sw, m, vol, lo, span_z, a, b, coordinate, crest)
+            on = flat_nonzero(g.detach() > 0)  # (the pixels that take the sweep's texture)
+            window = track_windows(sw.shape[1], j.index_select(0, on), tau_t.index_select(0, on), tau_b.index_select(0, on))
+            values, x_k, cov_k = self._swept_samples(im, i, wf, sw, m, window, vol, lo, span_z, a, b, coordinate, crest)
             avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g)
             texture[i] = texture[i].index_put((s,), g * avg[0])
             if crest:  # the active and residual covers
@@ -391,18 +393,22 @@ class TextureTable:
                 return cand, m
         raise AssertionError("unreachable")
 
-    def _swept_samples(self, im: int, i: int, wf: Any, sw: Sweep, m: torch.Tensor, vol: torch.Tensor, lo: torch.Tensor,
-                       span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any, crest: bool) -> tuple:
+    def _swept_samples(self, im: int, i: int, wf: Any, sw: Sweep, m: torch.Tensor, window: tuple, vol: torch.Tensor,
+                       lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any,
+                       crest: bool) -> tuple:
         """At the sweep's samples of image ``im`` (chunk index ``i``), given its running minimum m (nt, ns)
         (:meth:`_swept_envelope`): the texture and foam fraction (C, nt, ns), the resolved quantiles x
         (nt, ns) and the resolved covariance (3 of (ns,)). The slopes, the crest variable, the texture and
-        the foam are read only at the visible samples (:func:`visible_samples`: about half near grazing),
-        0 at the hidden ones, which no pixel sees."""
+        the foam are read only at the visible samples within the depressions ``window`` = (lo, hi) (nt,)
+        that the track's pixels see (:func:`visible_samples`: near grazing about half the samples are
+        hidden, and the sweep starts where the steepest ray might meet a crest of η_max, before the
+        windows), 0 elsewhere."""
         dtype = self.dtype
         ns, nt = sw.shape
         fp = sw.footprint[:, None].expand(ns, nt).reshape(1, -1)
         X, Y, t_s = sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1]
-        sel = flat_nonzero(visible_samples(m.T, dim=0))  # the visible samples, sample-major (ns, nt)
+        # the samples read, sample-major (ns, nt)
+        sel = flat_nonzero(visible_samples(m.T, dim=0, window=(window[0][None, :], window[1][None, :])))
         row = torch.div(sel, nt, rounding_mode="floor")
         col = sel - row * nt
         pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731  (faster than v[idx] on CPU)

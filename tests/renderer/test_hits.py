@@ -308,6 +308,33 @@ def test_sweep_until_keeps_every_window_that_reaches_its_least_depression():
         assert abs(float(avg[0, i]) - share) < 0.02, (i, float(avg[0, i]), share)
 
 
+def test_visible_samples_within_the_windows_hold_what_their_rays_reach():
+    """The same two crests; the windows of a track span the depressions [0.06, 0.09]. Every sample that a
+    ray of those depressions reaches (seen, brute force as above, at a depression within them) is among
+    ``visible_samples(m, window=...)``, so are both ends of the element each ray of them first meets (a
+    brute-force march on the samples, 31 rays from 0.06 to 0.09: the partial elements at the windows'
+    edges), and each selected sample lies between the first hits of the steepest and shallowest rays,
+    one sample either side; samples before and beyond (the flat sea in front, the far field) are left
+    out. Planted, the window tested on the element's near end only (m[k] ≤ hi instead of m[k + 1] ≤ hi):
+    the steepest ray's element loses its near end; the window ignored: the last check fails."""
+    r = torch.linspace(20.0, 400.0, 1901, dtype=F64)
+    eta = _bump(r) + _bump(r, at=140.0, height=1.5, width=3.0)
+    t, m = sweep_envelope(_sweep(r), eta[:, None])
+    lo, hi = 0.06, 0.09
+    sel = visible_samples(m, window=(torch.tensor([[lo]], dtype=F64), torch.tensor([[hi]], dtype=F64)))[0]
+    line = H_CAM - (H_CAM - eta)[None, :] * r[:, None] / r[None, :]
+    seen = torch.tensor([bool((line[:k, k] > eta[:k]).all()) for k in range(r.shape[0])])
+    reached = seen & (t[0] >= lo) & (t[0] <= hi)
+    assert int(reached.sum()) > 50 and bool(sel[reached].all())
+    for tau in torch.linspace(lo, hi, 31, dtype=F64).tolist():
+        k = int(((H_CAM - tau * r) <= eta).to(torch.int8).argmax())
+        assert bool(sel[k - 1]) and bool(sel[k]), tau
+    first, last = _brute_first_hit(r, eta, hi), _brute_first_hit(r, eta, lo)
+    dr = float(r[1] - r[0]) * 1.01
+    assert bool(((r[sel] >= first - dr) & (r[sel] <= last + dr)).all())
+    assert int(sel.sum()) < int(visible_samples(m)[0].sum())
+
+
 def test_pixel_hits_is_the_average_and_the_centre_hit_of_one_search():
     """:func:`pixel_hits` (one search for the windows' edges and the centre rays) gives what
     :func:`visible_average` and :func:`centre_element` give apart, on a crest with tracks of different
