@@ -33,6 +33,14 @@ Method (the running horizon of height-field renderers, applied to the sea):
   the expectation image. So the sweep's part fades out with the pixel's own footprint
   (:func:`footprint_fade`), to exactly 0 where the pixel resolves no band: the far field is the
   expectation image.
+- Only what some pixel sees is read. The elevation is read at every sample up to the first that the
+  shallowest window of a pixel with g > 0 must reach (:meth:`Sweep.until`, for any surface within the
+  sweep's elevation bound; :func:`covers` checks it after the running minimum); the slopes, crest
+  variable, texture and foam only at the visible samples whose elements meet the depressions the
+  track's pixels' windows span (:func:`visible_samples` with a window, :func:`track_windows`). What
+  is left out (the flat sea between the sweep's start and the nearest window, hidden troughs, the
+  rows beyond the last window) would enter a pixel's average only through the cumulative sum's part
+  before its window, which cancels.
 
 Everything is differentiable in the wind (through η, the slopes and the crest variable) and the pose
 (through t and the pixels' depressions); the choice of samples and elements is not (indices are
