@@ -33,6 +33,14 @@ Method (the running horizon of height-field renderers, applied to the sea):
   the expectation image. So the sweep's part fades out with the pixel's own footprint
   (:func:`footprint_fade`), to exactly 0 where the pixel resolves no band: the far field is the
   expectation image.
+- Only what some pixel sees is read. The elevation is read at every sample up to the first that the
+  shallowest window of a pixel with g > 0 must reach (:meth:`Sweep.until`, for any surface within the
+  sweep's elevation bound; :func:`covers` checks it after the running minimum); the slopes, crest
+  variable, texture and foam only at the visible samples whose elements meet the depressions the
+  track's pixels' windows span (:func:`visible_samples` with a window, :func:`track_windows`). What
+  is left out (the flat sea between the sweep's start and the nearest window, hidden troughs, the
+  rows beyond the last window) would enter a pixel's average only through the cumulative sum's part
+  before its window, which cancels.
 
 Everything is differentiable in the wind (through η, the slopes and the crest variable) and the pose
 (through t and the pixels' depressions); the choice of samples and elements is not (indices are
@@ -59,7 +67,7 @@ import torch
 from ..clutter import footprint
 from ..wave_bands import band_window
 
-__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "visible_samples", "flat_nonzero", "pixel_windows", "visible_average",
+__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "track_windows", "covers", "visible_samples", "flat_nonzero", "pixel_windows", "visible_average",
            "centre_element", "pixel_hits", "sample_step", "footprint_fade"]
 
 
@@ -92,7 +100,9 @@ def footprint_fade(field: Any, image: int, pixel_footprint: torch.Tensor) -> tor
 class Sweep:
     """One image's sweep: sample distances ``r`` (ns,) [m] and track azimuths ``az`` (nt,) [rad], the
     points (``x``, ``y``: (ns, nt) world [m]) and their footprints ``footprint`` (ns,) [m]; the camera's
-    height ``h`` [m] and the curvature term ``curv`` = 1/(2R) [m⁻¹]."""
+    height ``h`` [m] and the curvature term ``curv`` = 1/(2R) [m⁻¹]; the first track's azimuth ``p0``
+    and the tracks' spacing ``dphi`` [rad]; ``eta_max`` [m], the bound of the resolved elevation
+    :func:`sweep_layout` assumed (:meth:`until`)."""
 
     r: torch.Tensor
     az: torch.Tensor
@@ -103,6 +113,7 @@ class Sweep:
     curv: float
     p0: float
     dphi: float
+    eta_max: float = 0.0
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -111,6 +122,23 @@ class Sweep:
     def flat_depression(self) -> torch.Tensor:
         """t0 (ns,): the depression of the flat sea's point at each sample."""
         return (self.h + self.curv * self.r * self.r) / self.r
+
+    def until(self, tau: float) -> "Sweep":
+        """The sweep's first samples (the same points), up to the first whose depression is ≤ ``tau`` (a
+        tangent) for any surface within ±``eta_max``: (h + η_max + r²/(2R))/r ≤ τ. A ray of depression
+        τ' ≥ τ first meets that surface at or before it, so every pixel whose window's upper edge is at
+        least τ reads the same elements of the shorter sweep as of the whole one (its running minimum
+        along a track depends only on the samples before; :func:`covers` checks it after the fact). The
+        whole sweep where no sample qualifies."""
+        ns = self.r.shape[0]
+        r = self.r.detach()
+        t_hi = (float(self.h.detach()) + self.eta_max + self.curv * r * r) / r
+        k = flat_nonzero(t_hi <= tau)
+        if k.numel() == 0 or int(k[0]) >= ns - 1:
+            return self
+        n = max(int(k[0]) + 1, 2)
+        return Sweep(self.r[:n], self.az, self.x[:n], self.y[:n], self.footprint[:n], self.h, self.curv, self.p0,
+                     self.dphi, self.eta_max)
 
 
 def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, tan_g: torch.Tensor, phi: torch.Tensor,
@@ -163,7 +191,7 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     rho = torch.sqrt(r * r + hf * hf)
     scale = 2.0 * torch.as_tensor(sample_step(np.sin(gam), step, min_step, across), dtype=dtype, device=device)
     fp = footprint(rho, hf / rho, ifov * scale)
-    return Sweep(r, az, x, y, fp, h.to(dtype), curv, p0, dphi)
+    return Sweep(r, az, x, y, fp, h.to(dtype), curv, p0, dphi, eta_max)
 
 
 def sweep_envelope(sweep: Sweep, eta: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
@@ -175,12 +203,36 @@ def sweep_envelope(sweep: Sweep, eta: torch.Tensor) -> tuple[torch.Tensor, torch
     return t, torch.cummin(t.detach(), dim=1).values
 
 
-def visible_samples(m: torch.Tensor, dim: int = -1) -> torch.Tensor:
+def track_windows(nt: int, j: torch.Tensor, tau_top: torch.Tensor, tau_bottom: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """(lo, hi), each (nt,): the least upper edge and the largest lower edge (depressions, tangents) of the
+    windows of the pixels on each track (``j`` (P,) their tracks); +inf and −inf on tracks without any."""
+    lo = torch.full((nt,), math.inf, dtype=tau_top.dtype, device=tau_top.device)
+    hi = torch.full((nt,), -math.inf, dtype=tau_top.dtype, device=tau_top.device)
+    return (lo.scatter_reduce(0, j, tau_top.detach(), "amin"), hi.scatter_reduce(0, j, tau_bottom.detach(), "amax"))
+
+
+def covers(m: torch.Tensor, j: torch.Tensor, tau_top: torch.Tensor) -> bool:
+    """Whether the running minimum m (nt, ns) of a sweep reaches, on each pixel's track ``j`` (P,), the
+    depression of its window's upper edge ``tau_top`` (P,) by its last sample: then the pixel's window
+    ends within the sweep, and more samples beyond would not change what it sees."""
+    return bool((m[:, -1].index_select(0, j) <= tau_top.detach()).all())
+
+
+def visible_samples(m: torch.Tensor, dim: int = -1, window: tuple[torch.Tensor, torch.Tensor] | None = None) -> torch.Tensor:
     """The samples that bound a visible element (m[k] > m[k + 1] on either side along ``dim``, the samples'
     axis: -1 for m (nt, ns), 0 for its transpose), the only ones :func:`visible_average` and
-    :func:`centre_element` read (a hidden element spans no depression); bool of m's shape, contiguous."""
+    :func:`centre_element` read (a hidden element spans no depression); bool of m's shape, contiguous.
+
+    ``window`` = (lo, hi), each track's depressions (tangents) that its pixels' windows span (broadcasting
+    against m along the tracks' axis, e.g. (nt, 1) for m (nt, ns)): only the visible elements whose
+    depressions [m[k + 1], m[k]] meet [lo, hi]. The others lie before every window of their track or
+    beyond it: they enter a pixel's average only through the cumulative sum's part before its window,
+    which cancels (their values may be anything finite, e.g. 0, at float rounding)."""
     n = m.shape[dim]
-    span = m.narrow(dim, 0, n - 1) > m.narrow(dim, 1, n - 1)
+    near, far = m.narrow(dim, 0, n - 1), m.narrow(dim, 1, n - 1)
+    span = near > far
+    if window is not None:
+        span &= (far <= window[1]) & (near >= window[0])
     vis = torch.zeros(m.shape, dtype=torch.bool, device=m.device)
     vis.narrow(dim, 0, n - 1).copy_(span)
     vis.narrow(dim, 1, n - 1).logical_or_(span)

@@ -28,8 +28,8 @@ from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
-from .hits import (Sweep, flat_nonzero, footprint_fade, pixel_hits, pixel_windows, sample_step, sweep_envelope, sweep_layout,
-                   visible_samples)
+from .hits import (Sweep, covers, flat_nonzero, footprint_fade, pixel_hits, pixel_windows, sample_step, sweep_envelope,
+                   sweep_layout, track_windows, visible_samples)
 from .path import path_rows
 from .scene import SceneParameters
 from .sky_terms import sky_per_image
@@ -336,15 +336,19 @@ class TextureTable:
                     f_pix[c][i] = f_pix[c][i].index_put((s,), flat[c])
             if sw is None:
                 continue
-            values, x_k, cov_k, m = self._swept_samples(im, i, wf, sw, vol, lo, span_z, a, b, coordinate, crest)
-            j = ((phi.detach() - sw.p0) / sw.dphi).round().clamp(0, sw.az.shape[0] - 1).long()
             tau_t, tau_b = pixel_windows(tan_g, float(self.ifov[im]))
+            j = ((phi.detach() - sw.p0) / sw.dphi).round().clamp(0, sw.az.shape[0] - 1).long()
+            sw, m = self._swept_envelope(im, wf, sw, j, tau_t, g)
+            on = flat_nonzero(g.detach() > 0)  # (the pixels that take the sweep's texture)
+            window = track_windows(sw.shape[1], j.index_select(0, on), tau_t.index_select(0, on), tau_b.index_select(0, on))
+            values, x_k, cov_k = self._swept_samples(im, i, wf, sw, m, window, vol, lo, span_z, a, b, coordinate, crest)
             avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g)
             texture[i] = texture[i].index_put((s,), g * avg[0])
             if crest:  # the active and residual covers
                 for c in range(2):
                     f_pix[c][i] = f_pix[c][i].index_put((s,), flat[c] + g * avg[1 + c])
-            x_c[i] = x_c[i].index_put((s,), torch.where(hit, x_k[j, k], torch.zeros_like(tan_g)))
+            # (x = 0 where g = 0: the pixel resolves nothing, its resolved covariance g² C is 0 too)
+            x_c[i] = x_c[i].index_put((s,), torch.where(hit & (g.detach() > 0), x_k[j, k], torch.zeros_like(tan_g)))
             for c in range(3):  # (g² C: the glint's resolved part fades with the texture)
                 cov_c[c][i] = cov_c[c][i].index_put((s,), g * g * cov_k[c][k])
         return texture, (x_c, x_c), tuple(cov_c), f_pix
@@ -369,20 +373,42 @@ class TextureTable:
         w = 1.0 - pick(g)
         return [o.index_put((need,), w * f[0]) for o, f in zip(out, covers)]
 
-    def _swept_samples(self, im: int, i: int, wf: Any, sw: Sweep, vol: torch.Tensor, lo: torch.Tensor,
-                       span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any, crest: bool) -> tuple:
-        """At the sweep's samples of image ``im`` (chunk index ``i``): the texture and foam fraction
-        (C, nt, ns), the resolved quantiles x (nt, ns), the resolved covariance (3 of (ns,)) and the
-        running minimum m (nt, ns) of the envelope. The elevation is read at every sample; the slopes,
-        the crest variable, the texture and the foam only at the visible ones (:func:`visible_samples`:
-        about half near grazing), 0 at the hidden ones, which no pixel sees."""
+    def _swept_envelope(self, im: int, wf: Any, sw: Sweep, j: torch.Tensor, tau_top: torch.Tensor,
+                        g: torch.Tensor) -> tuple[Sweep, torch.Tensor]:
+        """(the sweep, its running minimum m (nt, ns)) of image ``im``: the elevation read at every sample
+        up to the last that a pixel taking the sweep's texture (g > 0) can see (:meth:`Sweep.until` the
+        least upper edge ``tau_top`` of their windows; the rows beyond, where g = 0, are the expectation
+        image), the whole sweep where that prefix would not reach some window's edge (:func:`covers`:
+        an elevation beyond the sweep's bound η_max)."""
+        on = flat_nonzero(g.detach() > 0)
+        jo, to = j.index_select(0, on), tau_top.index_select(0, on)
+        short = sw.until(float(to.min()))
+        for cand in ((short, sw) if short is not sw else (sw,)):
+            ns, nt = cand.shape
+            fp = cand.footprint[:, None].expand(ns, nt).reshape(1, -1)
+            eta = wf.sample_unchecked(cand.x.reshape(1, -1), cand.y.reshape(1, -1), self.time[im:im + 1], fp,
+                                      elevation=True, crest=False, slopes=False)["elevation"]
+            _, m = sweep_envelope(cand, eta[0].reshape(ns, nt))
+            if cand is sw or covers(m, jo, to):
+                return cand, m
+        raise AssertionError("unreachable")
+
+    def _swept_samples(self, im: int, i: int, wf: Any, sw: Sweep, m: torch.Tensor, window: tuple, vol: torch.Tensor,
+                       lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any,
+                       crest: bool) -> tuple:
+        """At the sweep's samples of image ``im`` (chunk index ``i``), given its running minimum m (nt, ns)
+        (:meth:`_swept_envelope`): the texture and foam fraction (C, nt, ns), the resolved quantiles x
+        (nt, ns) and the resolved covariance (3 of (ns,)). The slopes, the crest variable, the texture and
+        the foam are read only at the visible samples within the depressions ``window`` = (lo, hi) (nt,)
+        that the track's pixels see (:func:`visible_samples`: near grazing about half the samples are
+        hidden, and the sweep starts where the steepest ray might meet a crest of η_max, before the
+        windows), 0 elsewhere."""
         dtype = self.dtype
         ns, nt = sw.shape
         fp = sw.footprint[:, None].expand(ns, nt).reshape(1, -1)
         X, Y, t_s = sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1]
-        eta = wf.sample_unchecked(X, Y, t_s, fp, elevation=True, crest=False, slopes=False)["elevation"]
-        t, m = sweep_envelope(sw, eta[0].reshape(ns, nt))
-        sel = flat_nonzero(visible_samples(m.T, dim=0))  # the visible samples, sample-major (ns, nt)
+        # the samples read, sample-major (ns, nt)
+        sel = flat_nonzero(visible_samples(m.T, dim=0, window=(window[0][None, :], window[1][None, :])))
         row = torch.div(sel, nt, rounding_mode="floor")
         col = sel - row * nt
         pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731  (faster than v[idx] on CPU)
@@ -409,7 +435,7 @@ class TextureTable:
         # back to every sample (0 at the hidden ones), in the (nt, ns) layout of the envelope
         full = x_v.new_zeros(len(values) + 1, nt * ns).index_copy(1, col * ns + row, torch.stack(values + [x_v]))
         full = full.reshape(-1, nt, ns)
-        return full[:-1], full[-1], cov_k, m
+        return full[:-1], full[-1], cov_k
 
     def _row_statistics(self, sl: slice, wf: Any, gy: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor,
                         h: torch.Tensor, crest: bool) -> torch.Tensor:

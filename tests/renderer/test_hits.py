@@ -11,8 +11,8 @@ import torch
 
 import roughsea_torch as rs
 from roughsea_torch.raytrace import raytraced_image
-from roughsea_torch.renderer.hits import (Sweep, centre_element, footprint_fade, pixel_hits, pixel_windows, sample_step,
-                                          sweep_envelope, visible_average, visible_samples)
+from roughsea_torch.renderer.hits import (Sweep, centre_element, covers, footprint_fade, pixel_hits, pixel_windows,
+                                          sample_step, sweep_envelope, visible_average, visible_samples)
 
 F64 = torch.float64
 H_CAM = 10.0
@@ -266,6 +266,73 @@ def test_visible_samples_hold_every_point_a_ray_reaches():
     assert bool((seen | torch.roll(seen, -1))[vis].all())
     assert float((~vis).double().mean()) > 0.05  # the shadows behind the crests (13 %)
     assert torch.equal(visible_samples(m.T, dim=0).T, visible_samples(m))  # the samples' axis first: the same
+
+
+def test_sweep_until_keeps_every_window_that_reaches_its_least_depression():
+    """A 2 m crest at 100 m and a 1.8 m deep trough about 200 m, camera 10 m up, |η| ≤ 2 m: the sweep cut
+    by ``Sweep.until(0.05)`` (the flat point of depression 0.05 is at 200 m, in the trough; the ray meets
+    the surface at ~236 m) still holds the first hit of every ray of depression ≥ 0.05 (brute force on a
+    dense profile, to a sample), and each window [τ_top ≥ 0.05, τ_bottom] sees the share of the crest's
+    near face and of the surface from 180 to 240 m (the trough's far side) that a brute-force fan of rays sees; ``covers`` says so. The
+    shorter sweep ends within 10 m of where (h + η_max)/r = 0.05 (240 m). Planted, ``until`` ignoring
+    η_max (a cut at the flat point): the rays beyond 200 m are lost, ``covers`` is False and the first
+    check fails."""
+    r = torch.linspace(20.0, 400.0, 3801, dtype=F64)
+    profile = lambda x: _bump(x) - 1.8 * torch.exp(-0.5 * ((x - 215.0) / 25.0) ** 2)  # noqa: E731
+    sw = Sweep(r, torch.zeros(1, dtype=F64), r[:, None], 0 * r[:, None], r, torch.tensor(H_CAM, dtype=F64), 0.0, 0.0,
+               1.0, 2.0)
+    short = sw.until(0.05)
+    assert short.shape[0] < sw.shape[0] and abs(float(short.r[-1]) - 240.0) < 10.0
+    assert torch.equal(short.r, r[:short.shape[0]])
+    _, m = sweep_envelope(short, profile(short.r)[:, None])
+    tau = torch.tensor([0.05, 0.051, 0.06, 0.08, 0.1, 0.2], dtype=F64)
+    j = torch.zeros(tau.shape[0], dtype=torch.long)
+    dense = torch.linspace(20.0, 400.0, 38001, dtype=F64)
+    dense_eta = profile(dense)
+    k, hit = centre_element(m, j, tau)
+    for i, t in enumerate(tau.tolist()):
+        truth = _brute_first_hit(dense, dense_eta, t)
+        assert bool(hit[i]) and abs(float(short.r[k[i]]) - truth) <= 0.11, (t, float(short.r[k[i]]), truth)
+    t_top = torch.tensor([0.05, 0.055, 0.075], dtype=F64)
+    t_bot = torch.tensor([0.054, 0.07, 0.09], dtype=F64)
+    jw = torch.zeros(3, dtype=torch.long)
+    assert covers(m, jw, t_top)
+    face = ((r <= 100.0) & (r >= 88.0)) | ((r >= 180.0) & (r <= 240.0))
+    values = face.to(F64)[None, None, :short.shape[0]]
+    avg = visible_average(m, values, jw, t_top, t_bot)
+    for i in range(3):  # brute force: a fan of 400 rays over the window, each marched on the dense profile at once
+        fan = torch.linspace(float(t_top[i]), float(t_bot[i]), 402, dtype=F64)[1:-1, None]
+        below = (H_CAM - fan * dense[None, :]) <= dense_eta[None, :]
+        hits = dense[below.to(torch.int8).argmax(1)]
+        share = float((((hits <= 100.0) & (hits >= 88.0)) | ((hits >= 180.0) & (hits <= 240.0))).to(F64).mean())
+        assert abs(float(avg[0, i]) - share) < 0.02, (i, float(avg[0, i]), share)
+
+
+def test_visible_samples_within_the_windows_hold_what_their_rays_reach():
+    """The same two crests; the windows of a track span the depressions [0.06, 0.09]. Every sample that a
+    ray of those depressions reaches (seen, brute force as above, at a depression within them) is among
+    ``visible_samples(m, window=...)``, so are both ends of the element each ray of them first meets (a
+    brute-force march on the samples, 31 rays from 0.06 to 0.09: the partial elements at the windows'
+    edges), and each selected sample lies between the first hits of the steepest and shallowest rays,
+    one sample either side; samples before and beyond (the flat sea in front, the far field) are left
+    out. Planted, the window tested on the element's near end only (m[k] ≤ hi instead of m[k + 1] ≤ hi):
+    the steepest ray's element loses its near end; the window ignored: the last check fails."""
+    r = torch.linspace(20.0, 400.0, 1901, dtype=F64)
+    eta = _bump(r) + _bump(r, at=140.0, height=1.5, width=3.0)
+    t, m = sweep_envelope(_sweep(r), eta[:, None])
+    lo, hi = 0.06, 0.09
+    sel = visible_samples(m, window=(torch.tensor([[lo]], dtype=F64), torch.tensor([[hi]], dtype=F64)))[0]
+    line = H_CAM - (H_CAM - eta)[None, :] * r[:, None] / r[None, :]
+    seen = torch.tensor([bool((line[:k, k] > eta[:k]).all()) for k in range(r.shape[0])])
+    reached = seen & (t[0] >= lo) & (t[0] <= hi)
+    assert int(reached.sum()) > 50 and bool(sel[reached].all())
+    for tau in torch.linspace(lo, hi, 31, dtype=F64).tolist():
+        k = int(((H_CAM - tau * r) <= eta).to(torch.int8).argmax())
+        assert bool(sel[k - 1]) and bool(sel[k]), tau
+    first, last = _brute_first_hit(r, eta, hi), _brute_first_hit(r, eta, lo)
+    dr = float(r[1] - r[0]) * 1.01
+    assert bool(((r[sel] >= first - dr) & (r[sel] <= last + dr)).all())
+    assert int(sel.sum()) < int(visible_samples(m)[0].sum())
 
 
 def test_pixel_hits_is_the_average_and_the_centre_hit_of_one_search():
