@@ -21,12 +21,15 @@ import torch
 from .spectrum import GRAVITY, dispersion, eckv_terms
 from .wave_bands import WaveBands
 
-__all__ = ["CREST_CUTOFF", "CREST_HIGHPASS", "BandLattice"]
+__all__ = ["CREST_CUTOFF", "CREST_DIRECTIONAL", "CREST_HIGHPASS", "BandLattice"]
 
 # the crest variable's band pass (WaveField docstring, *Crest variable*): breaking crests travel at
 # c ≈ 0.2–0.5 c_p (Melville & Matusov 2002; Gemmrich, Banner & Garrett 2008), k = (c_p/c)² k_p
 CREST_CUTOFF = 25.0  # k_b / k_p of the low pass (c ≈ 0.2 c_p)
 CREST_HIGHPASS = 4.0  # k_lo / k_p of the high pass (c ≈ 0.5 c_p); 0 with CREST_CUTOFF 10 is the old low pass
+# p of the crest gain's directional factor |cos φ|^p (φ from the wind axis): breaking patches elongated
+# across the wind with the axis ratio measured by Korinenko et al. 2024 (0.41); 0 is the spectrum's spreading
+CREST_DIRECTIONAL = 1.5
 
 
 class BandLattice:
@@ -131,12 +134,15 @@ class BandLattice:
             dim=-1,
         )
         # the crest variable (WaveField docstring): G(k) = ω²/g × |2nd-order Butterworth band pass k_lo–k_b|
+        # × |cos φ|^p, φ the angle of k from the wind axis
         k_p = GRAVITY * omega_c**2 / wind**2  # ECKV Eq. 3
         k_b = CREST_CUTOFF * k_p
         gain = self.omega**2 / GRAVITY * torch.rsqrt(1.0 + (self.k / k_b) ** 4)
         if CREST_HIGHPASS > 0:
             q = (self.k / (CREST_HIGHPASS * k_p)) ** 2
             gain = gain * q * torch.rsqrt(1.0 + q**2)
+        if CREST_DIRECTIONAL > 0:
+            gain = gain * (along.abs() / self.k) ** CREST_DIRECTIONAL
         gain = torch.where(self.mask, gain, torch.zeros_like(gain))
         variance = torch.stack([weight.sum(dim=(-2, -1)), (weight * gain**2).sum(dim=(-2, -1))], dim=-1)
         return h0, cov, sign, gain, variance

@@ -27,7 +27,7 @@ from .spectrum import (C_M, GRAVITY, K_M, check_wave_age, check_wind_speed, disp
                        elfouhaily_spectrum, elfouhaily_spreading)
 from .spectrum import MAX_WIND, VON_KARMAN  # noqa: F401  (re-exported: roughsea_torch.waves.MAX_WIND as before)
 from .wave_bands import WINDOW_HI, WINDOW_LO, WaveBands, band_window
-from .wave_lattice import CREST_CUTOFF, CREST_HIGHPASS, BandLattice
+from .wave_lattice import CREST_CUTOFF, CREST_DIRECTIONAL, CREST_HIGHPASS, BandLattice
 
 __all__ = [
     "GRAVITY",
@@ -38,6 +38,7 @@ __all__ = [
     "elfouhaily_spreading",
     "elfouhaily_spectrum",
     "CREST_CUTOFF",
+    "CREST_DIRECTIONAL",
     "CREST_HIGHPASS",
     "WaveBands",
     "WaveField",
@@ -127,7 +128,7 @@ class WaveField:
         :meth:`sample` returns at a footprint (position averages, like :meth:`resolved_covariance`).
 
     Crest variable (``sample(..., crest=True)``; where foam goes, :func:`~roughsea_torch.foam.crest_foam_fraction`):
-        X = Σ_k G(k) H(k) e^{ik·x},  G(k) = (ω(k)²/g) q/√(1 + q²) / √(1 + (k/k_b)⁴),  q = (k/k_lo)²,
+        X = Σ_k G(k) H(k) e^{ik·x},  G(k) = (ω(k)²/g) q/√(1 + q²) / √(1 + (k/k_b)⁴) |cos φ|^p,  q = (k/k_lo)²,
         k_lo = ``CREST_HIGHPASS`` k_p = 4 k_p, k_b = ``CREST_CUTOFF`` k_p = 25 k_p, k_p = g Ω_c²/U10²
         (ECKV Eq. 3). For linear waves ∂²η/∂t² = −ω² η component by component, so X is the
         downward vertical acceleration of the surface in units of g, −a_z/g, of the waves between
@@ -135,7 +136,17 @@ class WaveField:
         breaking scales. Dimensionless, zero-mean Gaussian; each component's X is in phase with its
         elevation (X > 0 on crests) and in quadrature with its slope, so X and the slopes at a point
         are uncorrelated. Differentiable in the wind (k_lo and k_b move with k_p). Correlation
-        length along the wind at 15 m/s ≈ 4.4 m (1/e).
+        length along the wind at 15 m/s ≈ 4.4 m (1/e) without the directional factor.
+
+        Directional factor: φ is the angle of k from the wind axis and p = ``CREST_DIRECTIONAL`` = 1.5.
+        With the spectrum's own spreading (p = 0) the patches of X above its threshold are nearly
+        round (minor/major axis 0.62 on average, 10–25 m/s, 4 seeds); active breakers are ellipses
+        elongated along their crest, across the wind, with axis ratio 0.41 on average (Korinenko et al.
+        2024, Black Sea platform video). p weights X towards the waves travelling with the wind, whose
+        crests run across it, and was chosen so that the patches' axis ratio is 0.40–0.43
+        (``pipelines/whitecap_patches.py``): a calibration to that one measured shape, read as breaking
+        being more wind-aligned than the waves' energy. E[f] = W holds for any p (the threshold uses
+        X's own variance).
 
         Band limits: breaking crests travel at c ≈ 0.2–0.5 c_p (the breaking-crest length
         distribution Λ(c): Phillips 1985, J. Fluid Mech. 156; Melville & Matusov 2002, Nature 417,
