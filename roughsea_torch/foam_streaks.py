@@ -100,6 +100,27 @@ def streak_noise(x: torch.Tensor, y: torch.Tensor, seeds: Sequence[int], cos_win
         wu = (torch.cos(0.5 * math.pi * fu), torch.sin(0.5 * math.pi * fu))
         wv = (torch.cos(0.5 * math.pi * fv), torch.sin(0.5 * math.pi * fv))
         i0, j0 = iu.to(torch.int64), iv.to(torch.int64)
-        nu = sum(wu[p] * wv[q] * _node_normal(base[i], i0 + p, j0 + q) for p in (0, 1) for q in (0, 1)).to(x.dtype)
+        nu = sum(wu[p] * wv[q] * z for (p, q), z in zip(_CORNERS, _corner_normals(base[i], i0, j0))).to(x.dtype)
         out.append(nu if where is None else torch.zeros_like(x[i]).index_put((where[i],), nu))
     return torch.stack(out)
+
+
+_CORNERS = ((0, 0), (0, 1), (1, 0), (1, 1))
+
+
+def _corner_normals(base: torch.Tensor, i0: torch.Tensor, j0: torch.Tensor) -> list[torch.Tensor]:
+    """z at the four corners (i0 + p, j0 + q) of each point's cell, in :data:`_CORNERS` order. Where the
+    points' cells fill their bounding box densely (at most 4 nodes per point), the box's nodes are hashed
+    once and looked up: one hash and one Φ⁻¹ per node instead of four per point, the same values bit for
+    bit; otherwise (points scattered over a large box) each corner is hashed per point."""
+    if i0.numel() == 0:
+        return [_node_normal(base, i0, j0)] * 4
+    ia, ja = int(i0.min()), int(j0.min())
+    ni, nj = int(i0.max()) - ia + 2, int(j0.max()) - ja + 2
+    if ni * nj > 4 * i0.numel():
+        return [_node_normal(base, i0 + p, j0 + q) for p, q in _CORNERS]
+    gi = torch.arange(ia, ia + ni, dtype=torch.int64, device=i0.device)[:, None]
+    gj = torch.arange(ja, ja + nj, dtype=torch.int64, device=i0.device)[None, :]
+    table = _node_normal(base, gi, gj).reshape(-1)
+    idx = (i0 - ia) * nj + (j0 - ja)
+    return [table.index_select(0, (idx + (p * nj + q)).reshape(-1)).reshape(idx.shape) for p, q in _CORNERS]
