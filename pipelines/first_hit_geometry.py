@@ -331,6 +331,8 @@ RENDER_SETTINGS = {  # TableSize fields (with texture_hit="first") of the render
     "quad": dict(texture_quadrature=(20, 20), texture_quadrature_width=7.5),
     "z65": dict(texture_zenith=65),
     "x33+quad+z65": dict(texture=33, texture_quadrature=(20, 20), texture_quadrature_width=7.5, texture_zenith=65),
+    "across0.5+min1/128": dict(texture_hit_across=0.5, texture_hit_min_step=1 / 128),
+    "x17+across0.5+min1/128": dict(texture=17, texture_hit_across=0.5, texture_hit_min_step=1 / 128),
 }
 
 
