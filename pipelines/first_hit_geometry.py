@@ -28,9 +28,9 @@ sweep's elevation reads, envelope and visible-sample count of each variant on a 
 
 Usage:
     python pipelines/first_hit_geometry.py [--wind 5] [--direction upwind] [--rows 8 40] [--rays 32]
-        [--variants n1:Fs n2:Fs/2 n4:Fs/4 n4:Fs/4:i n4:Fs n8:k64] [--render default x17]
+        [--variants n1:Fs n2:Fs/2 n4:Fs/4 n4:Fs/4:i n4:Fs n8:k64] [--render x9 default]
     python pipelines/first_hit_geometry.py --cost [--variants ...]      # the sweep's reads and time at 256×320
-    python pipelines/first_hit_geometry.py --time-render default x17    # one 256×320 render per TableSize setting
+    python pipelines/first_hit_geometry.py --time-render x9 default    # one 256×320 render per TableSize setting
 """
 
 from __future__ import annotations
@@ -325,14 +325,13 @@ def report(case: Case, rows: slice, ray: dict, sweeps: dict, textured: dict) -> 
 
 
 RENDER_SETTINGS = {  # TableSize fields (with texture_hit="first") of the renderer's images compared
+    "x9": dict(texture_first=9),  # the first hit's node count before it became 17
     "default": {},
-    "x17": dict(texture=17),
-    "x33": dict(texture=33),
+    "x33": dict(texture_first=33),
     "quad": dict(texture_quadrature=(20, 20), texture_quadrature_width=7.5),
     "z65": dict(texture_zenith=65),
-    "x33+quad+z65": dict(texture=33, texture_quadrature=(20, 20), texture_quadrature_width=7.5, texture_zenith=65),
+    "x33+quad+z65": dict(texture_first=33, texture_quadrature=(20, 20), texture_quadrature_width=7.5, texture_zenith=65),
     "across0.5+min1/128": dict(texture_hit_across=0.5, texture_hit_min_step=1 / 128),
-    "x17+across0.5+min1/128": dict(texture=17, texture_hit_across=0.5, texture_hit_min_step=1 / 128),
 }
 
 

@@ -62,6 +62,10 @@ class TableSize:
     Args:
         texture: nodes in x = a/σ_a, the flat-point quantile of the resolved along-view slope,
             Chebyshev–Lobatto over ±``texture_width``; beyond it the border value.
+        texture_first: the same with ``texture_hit="first"``, where x is the resolved slope at the hit
+            as it is: the model's response is strongly curved in it near grazing, and 9 nodes (0 and
+            ±1.72 where the slopes are) lose 6–23 % of the clutter's contrast against the ray tracer
+            at 5 m/s, 81–88° (``docs/texture_first_geometry.md``); 17 nodes cost 1.0–1.25×.
         texture_zenith, texture_zenith_sun: ζ nodes of the texture (of a sunny scene, whose volume
             also carries the visible quantile x' = a'/σ_a of each pixel's unresolved Gaussian).
         texture_azimuth_sun: azimuth nodes of the texture of a sunny scene (on the mean table's span).
@@ -128,6 +132,7 @@ class TableSize:
     zenith_thin: int = 41
     fine_azimuth_thin: int = 128
     texture: int = 9
+    texture_first: int = 17
     texture_zenith: int = 33
     texture_zenith_sun: int = 65
     texture_width: float = 4.5
@@ -161,7 +166,7 @@ class TableSize:
             raise ValueError(f"TableSize.texture_hit must be 'first' or 'flat'; got {self.texture_hit!r}")
         if not isinstance(self.texture_antialias, (bool, np.bool_)):
             raise ValueError(f"TableSize.texture_antialias must be True or False; got {self.texture_antialias!r}")
-        for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin", "zenith_narrow", "azimuth_day", "texture",
+        for name in ("zenith", "azimuth", "azimuth_thin", "zenith_thin", "zenith_narrow", "azimuth_day", "texture", "texture_first",
                      "texture_zenith", "texture_zenith_sun", "texture_azimuth_sun", "glint"):
             if int(getattr(self, name)) < 2:
                 raise ValueError(f"TableSize.{name} must be >= 2")

@@ -71,7 +71,8 @@ class TextureTable:
         self.B, self.dtype, self.device = p.batch_size, dtype, device
         self.altitude, self.earth_radius_m, self.eps = altitude, earth_radius_m, eps
         self.width = float(table.texture_width)
-        xx, Lx, self.ex = lobatto_interp(int(table.texture), int(table.fine_texture))
+        n_x = int(table.texture_first if table.texture_hit == "first" else table.texture)
+        xx, Lx, self.ex = lobatto_interp(n_x, int(table.fine_texture))
         self.xnodes = torch.as_tensor(xx * self.width, dtype=dtype, device=device)
         self.Lx = torch.as_tensor(Lx, dtype=dtype, device=device)
         # with a sun the volume also carries the glint's visible quantile, which needs more ζ nodes
