@@ -85,7 +85,8 @@ TABLE = rs.TableSize()  # the renderer's settings; --texture-hit chooses where p
 HIT_OPTIONS = (("--hit-step", "texture_hit_step", "largest sample spacing in depression [px]"),
                ("--hit-min-step", "texture_hit_min_step", "smallest sample spacing [px]"),
                ("--hit-across", "texture_hit_across", "spacing across * cos(view zenith) / 2 [px]"),
-               ("--hit-tracks", "texture_hit_tracks", "ground tracks per pixel width"))
+               ("--hit-tracks", "texture_hit_tracks", "ground tracks per pixel width"),
+               ("--hit-visibility", "texture_hit_visibility", "elevation of the visibility at this x the sample footprint"))
 
 
 def selected(case: dict, patterns: list[str]) -> bool:

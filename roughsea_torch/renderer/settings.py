@@ -93,6 +93,11 @@ class TableSize:
             along the view: near grazing the waves down to ``across`` times the pixel's width across
             the view; :func:`~roughsea_torch.renderer.hits.sample_step`), and its ground tracks per
             pixel width.
+        texture_hit_visibility: in (0, 1]: the factor on the sweep's sample footprint F_s of the
+            elevation its running horizon (the visibility) is taken on; its spacings (step, min_step,
+            across) are scaled by it, while the slopes, crest, texture and foam stay filtered at F_s
+            (``docs/texture_first_geometry.md``). 1 (default): one layout; 0.5: the elevation at
+            F_s/2 on twice the samples.
         texture_antialias: True (default): the flat-point texture and crest-foam fraction are
             low-pass filtered along the image's columns, with a zero at the rows' Nyquist frequency
             (:mod:`~roughsea_torch.renderer.antialias`: the resolved band there would fold into
@@ -150,6 +155,7 @@ class TableSize:
     texture_hit_min_step: float = 0.03125
     texture_hit_across: float = 1.0
     texture_hit_tracks: float = 1.0
+    texture_hit_visibility: float = 1.0
     texture_azimuth_sun: int = 9
     zenith_narrow: int = 21
     azimuth_day: int = 25
@@ -183,7 +189,8 @@ class TableSize:
             object.__setattr__(self, name, tuple(int(v) for v in rule))  # hashable (tables are cached by it)
         for name, lo, hi in (("texture_steep_zenith_deg", 0.0, 90.0), ("texture_quadrature_width", 1.0, 40.0),
                              ("texture_hit_step", 0.01, 1.0), ("texture_hit_min_step", 0.001, 1.0),
-                             ("texture_hit_across", 0.1, 100.0), ("texture_hit_tracks", 0.25, 16.0)):
+                             ("texture_hit_across", 0.1, 100.0), ("texture_hit_tracks", 0.25, 16.0),
+                             ("texture_hit_visibility", 0.125, 1.0)):
             v = getattr(self, name)
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real) or not lo <= float(v) <= hi:
                 raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")

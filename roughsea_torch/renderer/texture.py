@@ -99,6 +99,10 @@ class TextureTable:
         self.hit_steps = dict(step=float(table.texture_hit_step), min_step=float(table.texture_hit_min_step),
                               across=float(table.texture_hit_across))
         self.hit_tracks = float(table.texture_hit_tracks)
+        # the layout the running horizon is built on: spacings × v, the elevation at v · F_s; the node
+        # values read at every visible sample with the footprint F_s = its footprint / v
+        self.hit_visibility = float(table.texture_hit_visibility)
+        self.hit_layout = {k: v * self.hit_visibility for k, v in self.hit_steps.items()}
         self.scaled = False  # whether some resolved slopes were scaled down (reconcile_scale)
 
     def _scale(self, cos_view: torch.Tensor) -> Any:
@@ -328,7 +332,7 @@ class TextureTable:
             sw = None
             if bool((g.detach() > 0).any()):  # (else no pixel resolves a band: the expectation image)
                 sw = sweep_layout(wf, 0, self.centres[im], self.altitude[im], tan_g, phi, float(self.ifov[im]),
-                                  self.earth_radius_m, tracks=self.hit_tracks, **self.hit_steps)
+                                  self.earth_radius_m, tracks=self.hit_tracks, **self.hit_layout)
             if sw is None:
                 g = torch.zeros_like(g)
             flat = self._flat_covers(im, wf, R, L, dx[i][s], dy[i][s], g) if crest else None
@@ -406,7 +410,8 @@ class TextureTable:
         windows), 0 elsewhere."""
         dtype = self.dtype
         ns, nt = sw.shape
-        fp = sw.footprint[:, None].expand(ns, nt).reshape(1, -1)
+        fpk = sw.footprint / self.hit_visibility  # (ns,) the node values' footprint F_s
+        fp = fpk[:, None].expand(ns, nt).reshape(1, -1)
         X, Y, t_s = sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1]
         # the samples read, sample-major (ns, nt)
         sel = flat_nonzero(visible_samples(m.T, dim=0, window=(window[0][None, :], window[1][None, :])))
@@ -415,7 +420,7 @@ class TextureTable:
         pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731  (faster than v[idx] on CPU)
         Xv, Yv, fv = pick(X, sel)[None], pick(Y, sel)[None], pick(fp, sel)[None]
         smp = wf.sample_unchecked(Xv, Yv, t_s, fv, elevation=False, crest=crest)
-        cov = wf.resolved_covariance(sw.footprint[None])  # 3 of (1, ns)
+        cov = wf.resolved_covariance(fpk[None])  # 3 of (1, ns)
         cov_k = tuple(c[0] for c in cov)
         cx, sx = torch.cos(sw.az), torch.sin(sw.az)  # the tracks' ray directions (camera → sea)
         x_v = resolved_quantile(smp["slope_x"][0], smp["slope_y"][0], tuple(pick(c, row) for c in cov_k), pick(cx, col),
@@ -429,7 +434,7 @@ class TextureTable:
         values = [self._read_volume(vol[i:i + 1], x_v[None, None], o[None, None], gy[None, None], a[i:i + 1],
                                     b[i:i + 1])[0, 0, 0]]
         if crest:
-            var_r = pick(wf.crest_variance(sw.footprint[None]), row)[None]
+            var_r = pick(wf.crest_variance(fpk[None]), row)[None]
             f_act, f_res = whitecap_cover(wf, Xv, Yv, t_s, fv, smp["crest"], var_r, wf.crest_variance()[:, None],
                                           self.p.foam[im:im + 1].to(dtype)[:, None], trails=self.foam_trails)
             values += [f_act[0], f_res[0]]

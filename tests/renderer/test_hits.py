@@ -377,6 +377,30 @@ def test_swept_render_matches_the_ray_tracer_near_grazing():
     assert float((a * b).mean()) / (sigma_a * sigma_b) > 0.9
 
 
+def test_visibility_on_the_finer_elevation_matches_the_ray_tracer():
+    """``TableSize.texture_hit_visibility=0.5`` (the running horizon on the elevation at half the samples'
+    footprint, twice the samples, node values still at the full footprint) against the brute-force ray
+    tracer on the camera of :func:`test_swept_render_matches_the_ray_tracer_near_grazing` (10 m/s upwind,
+    view zenith 85–88°): σ of the clutter within 0.95–1.1 of the ray-traced one and the noise-corrected
+    per-pixel correlation ≥ 0.99. (Measured 0.989 and 0.9986; the default v = 1 gives 0.965 and 0.9969.)
+    Planted, the node values read at the finer footprint too: σ 0.897 (the texture smoothed less, the
+    slopes' response not that of the pixel's band window); the layout not refined, its values read at
+    twice its footprint: r 0.949."""
+    cams = rs.make_camera(16, 32, hfov_deg=6.0, altitude_m=15.0, pitch_deg=-4.5, dtype=F64)
+    ray = raytraced_image(cams, 10.0, seed=11, time_s=3.0, rays_per_pixel=16)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        img = rs.render(cams, rs.SeaScene(wind_speed=10.0, sea_temperature=290.0, seed=11, time_s=3.0, foam=False,
+                                          path=False), output="brightness_temperature",
+                        table=rs.TableSize(texture_hit="first", texture_hit_visibility=0.5))
+    tb, noise = ray["brightness_temperature"][0, 0], ray["brightness_temperature_noise_var"][0, 0]
+    a = img.reshape(tb.shape) - img.reshape(tb.shape).mean(1, keepdim=True)
+    b = tb - tb.mean(1, keepdim=True)
+    sigma_a, sigma_b = float((a * a).mean().sqrt()), float(((b * b).mean() - noise.mean()).sqrt())
+    assert 0.95 < sigma_a / sigma_b < 1.1
+    assert float((a * b).mean()) / (sigma_a * sigma_b) > 0.99
+
+
 @pytest.mark.usefixtures("one_thread")
 def test_first_hit_texture_nodes_resolve_the_model_response():
     """The first hit reads the model's response at the resolved slope as it is, through a Chebyshev–Lobatto
