@@ -24,3 +24,12 @@ def test_texture_rules_accept_lists_and_numpy_numbers():
     for bad in (dict(texture_quadrature=(0, 16)), dict(texture_quadrature=(2.5, 16)), dict(texture_quadrature_width=0.5)):
         with pytest.raises(ValueError, match=f"TableSize.{next(iter(bad))}"):
             rs.TableSize(**bad)
+
+
+@pytest.mark.parametrize("bad", [dict(texture_hit="sideways"), dict(texture_first=1), dict(texture_hit_visibility=0.0),
+                                 dict(texture_hit_visibility=1.5), dict(texture_hit_visibility=float("nan"))])
+def test_first_hit_settings_out_of_range_name_themselves(bad):
+    """The first hit's settings: where a pixel meets the waves ('first' or 'flat'), its texture nodes (≥ 2)
+    and its visibility factor (in [0.125, 1]): anything else is a ValueError naming the field."""
+    with pytest.raises(ValueError, match=f"TableSize.{next(iter(bad))}"):
+        rs.TableSize(**bad)
