@@ -108,6 +108,18 @@ def check_foam(foam: Any, per_image: bool = True) -> Any:
     return foam
 
 
+def _per_image_value(name: str, what: str, value: Any, check: Any) -> Any:
+    """``value`` of a per-image scene argument ``name`` (a float or a (B,) tensor/array), checked by
+    ``check(name, value)``; a list, a tuple or more than one axis is a ValueError naming it."""
+    if isinstance(value, (list, tuple)):
+        raise ValueError(f"{name}: give a float or a tensor of shape (B,), {what}; got a "
+                         f"{type(value).__name__} (use torch.tensor(...))")
+    check(name, value)
+    if isinstance(value, (torch.Tensor, np.ndarray)) and value.ndim > 1:
+        raise ValueError(f"{name}: must be a float or a tensor of shape (B,); got shape {tuple(value.shape)}")
+    return value
+
+
 class SeaScene:
     """What is in front of the cameras, one value per image (floats or tensors of shape (B,)).
 
@@ -320,13 +332,7 @@ class SeaScene:
 
     @time_s.setter
     def time_s(self, value: Any) -> None:  # checked on every assignment (render_clip sets each frame's)
-        if isinstance(value, (list, tuple)):
-            raise ValueError("time_s: give a float or a tensor of shape (B,), one time per image; got a "
-                             f"{type(value).__name__} (use torch.tensor(...))")
-        check_time("time_s", value)
-        if isinstance(value, (torch.Tensor, np.ndarray)) and value.ndim > 1:
-            raise ValueError(f"time_s: must be a float or a tensor of shape (B,); got shape {tuple(value.shape)}")
-        self._time_s = value
+        self._time_s = _per_image_value("time_s", "one time per image", value, check_time)
 
     @property
     def skin_deficit(self) -> Any:
@@ -335,13 +341,7 @@ class SeaScene:
 
     @skin_deficit.setter
     def skin_deficit(self, value: Any) -> None:  # checked on every assignment, as time_s
-        if isinstance(value, (list, tuple)):
-            raise ValueError("skin_deficit: give a float or a tensor of shape (B,), one value per image; got a "
-                             f"{type(value).__name__} (use torch.tensor(...))")
-        check_skin_deficit("skin_deficit", value)
-        if isinstance(value, (torch.Tensor, np.ndarray)) and value.ndim > 1:
-            raise ValueError(f"skin_deficit: must be a float or a tensor of shape (B,); got shape {tuple(value.shape)}")
-        self._skin_deficit = value
+        self._skin_deficit = _per_image_value("skin_deficit", "one value per image", value, check_skin_deficit)
 
     @property
     def sun(self) -> Any:

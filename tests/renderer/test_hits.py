@@ -354,7 +354,29 @@ def test_pixel_hits_is_the_average_and_the_centre_hit_of_one_search():
     assert torch.equal(k, k0) and torch.equal(hit, hit0)
 
 
-def test_swept_render_matches_the_ray_tracer_near_grazing():
+@pytest.fixture(scope="module")
+def grazing_ray_trace():
+    """The camera both swept-render tests compare on (10 m/s upwind, 15 m mast, 4.5° down, 16×32 pixels
+    over 6°: view zenith 85–88°) and its brute-force ray trace (16 rays per pixel), traced once."""
+    cams = rs.make_camera(16, 32, hfov_deg=6.0, altitude_m=15.0, pitch_deg=-4.5, dtype=F64)
+    return cams, raytraced_image(cams, 10.0, seed=11, time_s=3.0, rays_per_pixel=16)
+
+
+def _against_the_ray_tracer(cams, ray, table) -> tuple[float, float]:
+    """σ of the render's clutter about the row means over the ray tracer's (its sampling variance
+    removed), and their noise-corrected per-pixel correlation."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        img = rs.render(cams, rs.SeaScene(wind_speed=10.0, sea_temperature=290.0, seed=11, time_s=3.0, foam=False,
+                                          path=False), output="brightness_temperature", table=table)
+    tb, noise = ray["brightness_temperature"][0, 0], ray["brightness_temperature_noise_var"][0, 0]
+    a = img.reshape(tb.shape) - img.reshape(tb.shape).mean(1, keepdim=True)
+    b = tb - tb.mean(1, keepdim=True)
+    sigma_a, sigma_b = float((a * a).mean().sqrt()), float(((b * b).mean() - noise.mean()).sqrt())
+    return sigma_a / sigma_b, float((a * b).mean()) / (sigma_a * sigma_b)
+
+
+def test_swept_render_matches_the_ray_tracer_near_grazing(grazing_ray_trace):
     """The swept texture against the brute-force ray tracer of the same realization (10 m/s upwind, 15 m
     mast, 4.5° down, 16×32 pixels over 6°: view zenith 85–88°, the pixel size of
     pipelines/texture_vs_raytrace.py): the clutter about the row means has σ within 0.85–1.2 of the
@@ -362,22 +384,11 @@ def test_swept_render_matches_the_ray_tracer_near_grazing():
     per pixel) removed. (Measured 0.95 and 0.997; the flat point gives 0.17 and 0.13.) Planted, the
     visible samples' texture scattered back in the wrong layout (sample-major, not track-major): 0.49 and
     −0.02."""
-    cams = rs.make_camera(16, 32, hfov_deg=6.0, altitude_m=15.0, pitch_deg=-4.5, dtype=F64)
-    ray = raytraced_image(cams, 10.0, seed=11, time_s=3.0, rays_per_pixel=16)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        img = rs.render(cams, rs.SeaScene(wind_speed=10.0, sea_temperature=290.0, seed=11, time_s=3.0, foam=False,
-                                          path=False), output="brightness_temperature",
-                        table=rs.TableSize(texture_hit="first"))
-    tb, noise = ray["brightness_temperature"][0, 0], ray["brightness_temperature_noise_var"][0, 0]
-    a = img.reshape(tb.shape) - img.reshape(tb.shape).mean(1, keepdim=True)
-    b = tb - tb.mean(1, keepdim=True)
-    sigma_a, sigma_b = float((a * a).mean().sqrt()), float(((b * b).mean() - noise.mean()).sqrt())
-    assert 0.85 < sigma_a / sigma_b < 1.2
-    assert float((a * b).mean()) / (sigma_a * sigma_b) > 0.9
+    ratio, r = _against_the_ray_tracer(*grazing_ray_trace, rs.TableSize(texture_hit="first"))
+    assert 0.85 < ratio < 1.2 and r > 0.9, (ratio, r)
 
 
-def test_visibility_on_the_finer_elevation_matches_the_ray_tracer():
+def test_visibility_on_the_finer_elevation_matches_the_ray_tracer(grazing_ray_trace):
     """``TableSize.texture_hit_visibility=0.5`` (the running horizon on the elevation at half the samples'
     footprint, twice the samples, node values still at the full footprint) against the brute-force ray
     tracer on the camera of :func:`test_swept_render_matches_the_ray_tracer_near_grazing` (10 m/s upwind,
@@ -386,19 +397,8 @@ def test_visibility_on_the_finer_elevation_matches_the_ray_tracer():
     Planted, the node values read at the finer footprint too: σ 0.897 (the texture smoothed less, the
     slopes' response not that of the pixel's band window); the layout not refined, its values read at
     twice its footprint: r 0.949."""
-    cams = rs.make_camera(16, 32, hfov_deg=6.0, altitude_m=15.0, pitch_deg=-4.5, dtype=F64)
-    ray = raytraced_image(cams, 10.0, seed=11, time_s=3.0, rays_per_pixel=16)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        img = rs.render(cams, rs.SeaScene(wind_speed=10.0, sea_temperature=290.0, seed=11, time_s=3.0, foam=False,
-                                          path=False), output="brightness_temperature",
-                        table=rs.TableSize(texture_hit="first", texture_hit_visibility=0.5))
-    tb, noise = ray["brightness_temperature"][0, 0], ray["brightness_temperature_noise_var"][0, 0]
-    a = img.reshape(tb.shape) - img.reshape(tb.shape).mean(1, keepdim=True)
-    b = tb - tb.mean(1, keepdim=True)
-    sigma_a, sigma_b = float((a * a).mean().sqrt()), float(((b * b).mean() - noise.mean()).sqrt())
-    assert 0.95 < sigma_a / sigma_b < 1.1
-    assert float((a * b).mean()) / (sigma_a * sigma_b) > 0.99
+    ratio, r = _against_the_ray_tracer(*grazing_ray_trace, rs.TableSize(texture_hit="first", texture_hit_visibility=0.5))
+    assert 0.95 < ratio < 1.1 and r > 0.99, (ratio, r)
 
 
 @pytest.mark.usefixtures("one_thread")
