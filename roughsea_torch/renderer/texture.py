@@ -385,18 +385,21 @@ class TextureTable:
         least upper edge ``tau_top`` of their windows; the rows beyond, where g = 0, are the expectation
         image), the whole sweep where that prefix would not reach some window's edge (:func:`covers`:
         an elevation beyond the sweep's bound η_max)."""
-        on = flat_nonzero(g.detach() > 0)
-        jo, to = j.index_select(0, on), tau_top.index_select(0, on)
-        short = sw.until(float(to.min()))
-        for cand in ((short, sw) if short is not sw else (sw,)):
+        def envelope(cand: Sweep) -> torch.Tensor:
             ns, nt = cand.shape
             fp = cand.footprint[:, None].expand(ns, nt).reshape(1, -1)
             eta = wf.sample_unchecked(cand.x.reshape(1, -1), cand.y.reshape(1, -1), self.time[im:im + 1], fp,
                                       elevation=True, crest=False, slopes=False)["elevation"]
-            _, m = sweep_envelope(cand, eta[0].reshape(ns, nt))
-            if cand is sw or covers(m, jo, to):
-                return cand, m
-        raise AssertionError("unreachable")
+            return sweep_envelope(cand, eta[0].reshape(ns, nt))[1]
+
+        on = flat_nonzero(g.detach() > 0)
+        jo, to = j.index_select(0, on), tau_top.index_select(0, on)
+        short = sw.until(float(to.min()))
+        if short is not sw:
+            m = envelope(short)
+            if covers(m, jo, to):
+                return short, m
+        return sw, envelope(sw)
 
     def _swept_samples(self, im: int, i: int, wf: Any, sw: Sweep, m: torch.Tensor, window: tuple, vol: torch.Tensor,
                        lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any,
