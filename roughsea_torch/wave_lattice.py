@@ -120,9 +120,12 @@ class BandLattice:
         amp = torch.where(positive, torch.sqrt(torch.where(positive, var, torch.ones_like(var))), torch.zeros_like(var))
         noise = self.white_noise(seed).to(self.device)
         h0 = noise * amp
-        # travel sign: +1 where k points downwind (k · upwind < 0), ties broken by the crosswind part
-        down = -along
-        sign = torch.where(down != 0, torch.sign(down), torch.sign(across))
+        # travel sign: +1 where k points downwind (k · upwind < 0), ties broken by the crosswind part. A tie is
+        # |k · upwind| ≤ 1e-6 k, not 0: a direction rounded to float32 (π/2 → cos = −4e-8) must not flip the
+        # waves across the wind (a wave that close to the cross axis has the same spectrum either way; what
+        # matters is that both dtypes of a direction make the same choice)
+        tie = along.abs() <= 1e-6 * self.k
+        sign = torch.where(tie, torch.sign(across), torch.sign(-along))
         sign = torch.where(self.mask, sign, torch.zeros_like(sign))
         weight = var * self.multiplicity * self.interp
         cov = torch.stack(

@@ -445,11 +445,13 @@ class SeaScene:
         of its crest variable's (default ``TableSize.texture_min_band_share``, 1e-8). The last 64 (per group of images the
         renderer asks for) are kept while the scene's wind, direction and seed are unchanged (their
         random amplitudes are drawn once)."""
-        wind = per_batch("wind_speed", self.wind_speed, B, dtype, device)[sl]
+        # (wind and direction in float64 whatever the render's dtype: the realization of a seed must not
+        # depend on it; the field keeps them in float64 and makes its tiles in ``dtype``)
+        wind = per_batch("wind_speed", self.wind_speed, B, torch.float64, device)[sl]
         if bool((wind.detach() == 0).any()):
             raise ValueError("wind_speed: a textured sea (SeaScene(seed=...)) needs a wind above 0 m/s; a calm sea has "
                              "no waves to draw: render it with seed=None (the expectation image)")
-        wd = per_batch("wind_direction", self.wind_direction, B, dtype, device)[sl]
+        wd = per_batch("wind_direction", self.wind_direction, B, torch.float64, device)[sl]
         seeds = self.seeds(B)[sl]
         share = TableSize.texture_min_band_share if min_band_share is None else float(min_band_share)
         key = (tuple(seeds), tuple(wind.detach().cpu().tolist()), tuple(wd.detach().cpu().tolist()), dtype, str(device),
