@@ -20,7 +20,8 @@ s_r − E[s_r | a] (Gaussian, independent of a) joins the unresolved covariance:
 
 So Σ_u + Cov(E[s_r | a]) = Σ exactly. The component across the line of sight tilts the reflected
 ray sideways, which for a sky symmetric in azimuth changes its zenith only to second order; it is
-kept statistical (its radiance effect stays in the mean, its texture is left out).
+kept statistical here (its radiance effect stays in the mean); the renderer's first hit adds its
+texture to second order (``TableSize.texture_hit_cross``, :mod:`roughsea_torch.renderer.texture`).
 
 Which slope a pixel sees (the Eq. 5 weighting of the resolved part). A ray meets a facet in
 proportion to the facet's visible projected area towards the sensor. Sampling the resolved slope

@@ -98,6 +98,14 @@ class TableSize:
             across) are scaled by it, while the slopes, crest, texture and foam stay filtered at F_s
             (``docs/texture_first_geometry.md``). 1 (default): one layout; 0.5: the elevation at
             F_s/2 on twice the samples.
+        texture_hit_cross: with ``texture_hit="first"``, the texture of the resolved slope *across* the
+            line of sight as well (default True): a tilt across the view turns the reflected ray
+            sideways and changes the radiance to second order, which crosswind near 80° carries a
+            third of the clutter's block variance (``docs/texture.md`` §5). The node values take it as
+            a quadratic in y = c_r/σ_r (the across-view residual of the resolved slope over its rms)
+            through y = ±√3 whose mean over y ~ N(0, 1) is the along-view node value (three-point
+            Gauss–Hermite), so the ensemble mean stays the along-view texture's; two more evaluations
+            per node. False: statistical, as with ``"flat"``.
         texture_antialias: True (default): the flat-point texture and crest-foam fraction are
             low-pass filtered along the image's columns, with a zero at the rows' Nyquist frequency
             (:mod:`~roughsea_torch.renderer.antialias`: the resolved band there would fold into
@@ -156,6 +164,7 @@ class TableSize:
     texture_hit_across: float = 1.0
     texture_hit_tracks: float = 1.0
     texture_hit_visibility: float = 1.0
+    texture_hit_cross: bool = True
     texture_azimuth_sun: int = 9
     zenith_narrow: int = 21
     azimuth_day: int = 25
@@ -195,6 +204,8 @@ class TableSize:
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real) or not lo <= float(v) <= hi:
                 raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")
             object.__setattr__(self, name, float(v))
+        if not isinstance(self.texture_hit_cross, (bool, np.bool_)):
+            raise ValueError(f"TableSize.texture_hit_cross must be a bool; got {self.texture_hit_cross!r}")
         if not isinstance(self.foam_trails, (bool, np.bool_)):
             raise ValueError(f"TableSize.foam_trails must be a bool; got {self.foam_trails!r}")
         if not isinstance(self.glitter, (bool, np.bool_)):

@@ -41,6 +41,7 @@ __all__ = ["TextureTable", "sky_of_chunk", "single_quantile", "warn_scaled", "SC
 # variance more than halved): the texture is then markedly weaker than the spectrum alone would give.
 # Milder scalings (light winds near range, by design: docs/texture.md §7) pass silently.
 SCALE_WARNING = 0.7
+_ROOT3 = math.sqrt(3.0)
 
 
 class TextureTable:
@@ -53,7 +54,9 @@ class TextureTable:
     ``grid_sample`` of the two slices of x about the pixel, and a lerp). The nodes' footprint,
     resolved covariance and unresolved Gaussian follow the node's (θ̂, φ̂) and the camera's range at
     θ̂ (for one camera the range is a function of θ̂); nodes where nothing is resolved (far field)
-    are not evaluated and hold Δ = 0.
+    are not evaluated and hold Δ = 0. With the first hit the volume also carries g and h of the
+    across-view slope's texture g y + h (y² − 1) (``TableSize.texture_hit_cross``; its last two
+    channels, y the across-view residual of the resolved slope over its rms, ``docs/texture.md`` §11).
 
     Args:
         table: the render's :class:`~roughsea_torch.renderer.settings.TableSize` (its texture fields).
@@ -92,6 +95,9 @@ class TextureTable:
         self.window = float(table.texture_quadrature_width)
         self.min_band_share = float(table.texture_min_band_share)
         self.first_hit = table.texture_hit == "first"
+        # the across-view resolved slope as texture too (first hit): two more channels, the quadratic's
+        # coefficients in y = c_r/σ_r (TableSize.texture_hit_cross)
+        self.cross = self.first_hit and bool(table.texture_hit_cross)
         self.foam_trails = bool(table.foam_trails)
         self.antialias = bool(table.texture_antialias)  # (renderer.antialias; the sweep is not filtered)
         # the sweep (TableSize.texture_hit_*): samples s(θ̂) pixels apart in depression, each filtered at
@@ -136,25 +142,31 @@ class TextureTable:
         dtype, device = self.dtype, self.device
         b_, nz, nphi = ph_nodes.shape[0], self.xz.numel(), ph_nodes.shape[1]
         nodes = self._active_nodes(sl, wf, ph_nodes, lo, span_z)
+        nx = self.xnodes.numel()
         if nodes is None:
-            zero = torch.zeros(b_, 1, nz, nphi, self.xnodes.numel(), dtype=dtype, device=device)
+            zero = torch.zeros(b_, 1, nz, nphi, nx, dtype=dtype, device=device)
             if self.scene.sun is not None:
                 zero = torch.cat([zero, self.xnodes.expand(b_, 1, nz, nphi, -1)], 1)
+            if self.cross:
+                zero = torch.cat([zero, zero[:, :1], zero[:, :1]], 1)
             return zero, torch.zeros(b_, dtype=torch.bool, device=device)
         active, idx, ct, ph, moments, x_vis = nodes
         img = idx[0]
         t_s, t_rho = self._reflection_by_rule(sl, sky, b_, idx, ct, ph, moments)
         rb = self.p.rb[sl][img, None].to(t_s.dtype)
         v = rb - rb * t_rho + t_s
-        delta = torch.zeros(b_, nz, nphi, self.xnodes.numel(), dtype=dtype, device=device)
-        delta = delta.index_put(idx, (v[:, :-1] - v[:, -1:]).to(dtype))
+        zero = torch.zeros(b_, nz, nphi, nx, dtype=dtype, device=device)
+        channels = [zero.index_put(idx, (v[:, :nx] - v[:, nx:nx + 1]).to(dtype))]
         if self.scene.sun is not None:  # channel 1: the visible quantile x' = a'/σ_a, for the glint (x' = x where
             # nothing is resolved: unused there)
-            xv = self.xnodes.expand(b_, nz, nphi, -1).clone().index_put(idx, x_vis.to(dtype))
-            delta = torch.stack([delta, xv], 1)
-        else:
-            delta = delta[:, None]
-        return delta, active.flatten(1).any(1)
+            channels.append(self.xnodes.expand(b_, nz, nphi, -1).clone().index_put(idx, x_vis.to(dtype)))
+        if self.cross:  # the last two: g, h of R(y) ≈ R̄ + g y + h (y² − 1), R̄ the along-view node value
+            # (the mean over y ~ N(0, 1)), through R(±√3): three-point Gauss–Hermite, exact for the quadratic
+            r_m, r_p = v[:, nx + 1:].unflatten(1, (2, nx)).unbind(1)
+            r_bar = v[:, :nx]
+            channels += [zero.index_put(idx, ((r_p - r_m) / (2.0 * _ROOT3)).to(dtype)),
+                         zero.index_put(idx, ((0.5 * (r_p + r_m) - r_bar) / 2.0).to(dtype))]
+        return torch.stack(channels, 1), active.flatten(1).any(1)
 
     def _active_nodes(self, sl: slice, wf: Any, ph_nodes: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor) -> Any:
         """The nodes of images ``sl`` that resolve a wave, or None: (active (b, nz, nphi) bool, their
@@ -198,7 +210,27 @@ class TextureTable:
                                                                           (shifted.var_crosswind, vy[img, 0, 0]),
                                                                           (shifted.cov, cxy[img, 0, 0]))]
         moments += [torch.cat([m, torch.zeros_like(m[:, :1])], 1) for m in (shifted.mean_upwind, shifted.mean_crosswind)]
+        if self.cross:  # 2 × nx more columns: the resolved across-view residual as geometry at y = ±√3
+            moments = self._cross_columns(moments, cov, phw, var_a, kap, full, ph, x.shape[1])
         return active, idx, ct, ph, moments, x_vis
+
+    @staticmethod
+    def _cross_columns(moments: list, cov: tuple, phw: torch.Tensor, var_a: torch.Tensor, kap: torch.Tensor,
+                       full: Any, ph: torch.Tensor, nx: int) -> list:
+        """The node columns with the resolved slope's across-view residual c_r (variance σ_r² = ê⊥ᵀ C ê⊥ −
+        κ_r² σ_a², independent of a) taken out of the unresolved covariance and put into the mean at
+        c_r = y σ_r, y = −√3, √3 (ê⊥ = ê turned +90°, in the upwind frame (−sin φ̂, cos φ̂)), appended
+        to the first nx columns of ``moments`` (var_up, var_cr, cov, mean_up, mean_cr)."""
+        var_p, _ = along_view(cov, -torch.sin(phw)[:, None, :], torch.cos(phw)[:, None, :])
+        var_r = full((var_p - kap * kap * var_a).clamp_min(0.0))[:, None]  # (M, 1)
+        sig_r = var_r.sqrt()
+        px, py = -torch.sin(ph)[:, None], torch.cos(ph)[:, None]
+        vu, vc, cv, mu, mc = (m[:, :nx] for m in moments)
+        extra = [vu - var_r * px * px, vc - var_r * py * py, cv - var_r * px * py]
+        out = [torch.cat([m] + [e] * 2, 1) for m, e in zip(moments[:3], extra)]
+        for m, mean, d in ((moments[3], mu, px), (moments[4], mc, py)):
+            out.append(torch.cat([m] + [mean + y * sig_r * d for y in (-_ROOT3, _ROOT3)], 1))
+        return out
 
     def _reflection_by_rule(self, sl: slice, sky: Any, b_: int, idx: tuple, ct: torch.Tensor, ph: torch.Tensor,
                             moments: list) -> tuple[torch.Tensor, torch.Tensor]:
@@ -252,10 +284,14 @@ class TextureTable:
             cos_rows = (self.eps[sl][:, None] * torch.sinh(lo[:, None] + span_z[:, None] * (y + 1) / 2)).clamp(0.0, 1.0).to(dtype)
             tau, _ = path_rows(self.scene.path, cos_rows, h[:, None], self.earth_radius_m)
             t_ = tau.to(dtype)[:, None, :, None, None]
+            # τ on the radiance channels: Δ and, with the across-view texture, its two coefficients (the last)
             if vol.requires_grad or t_.requires_grad:
-                vol = torch.cat([vol[:, :1] * t_, vol[:, 1:]], 1)
+                parts = [vol[:, :1] * t_, vol[:, 1:vol.shape[1] - 2 * self.cross]]
+                vol = torch.cat(parts + ([vol[:, -2:] * t_] if self.cross else []), 1)
             else:  # in place on the einsum's own output
                 vol[:, :1] *= t_
+                if self.cross:
+                    vol[:, -2:] *= t_
         return vol.flatten(-2)
 
     def pixels(self, sl: slice, vol: torch.Tensor, cos_t: torch.Tensor, zeta: torch.Tensor, o: torch.Tensor,
@@ -434,8 +470,13 @@ class TextureTable:
         zeta_k = torch.asinh(cos_k.double() / self.eps[im]).to(dtype)
         gy = pick((2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez), row)
         o = pick(coordinate(cx[None, None, :], sx[None, None, :], i), col)
-        values = [self._read_volume(vol[i:i + 1], x_v[None, None], o[None, None], gy[None, None], a[i:i + 1],
-                                    b[i:i + 1])[0, 0, 0]]
+        read = self._read_volume(vol[i:i + 1], x_v[None, None], o[None, None], gy[None, None], a[i:i + 1],
+                                 b[i:i + 1])[0, :, 0]  # (C, P)
+        values = [read[0]]
+        if self.cross:  # + g y + h (y² − 1), y the across-view residual of the resolved slope over its rms
+            y = _across_quantile(smp["slope_x"][0], smp["slope_y"][0], tuple(pick(c, row) for c in cov_k),
+                                 pick(cx, col), pick(sx, col), x_v)
+            values = [read[0] + read[-2] * y + read[-1] * (y * y - 1.0)]
         if crest:
             var_r = pick(wf.crest_variance(fpk[None]), row)[None]
             f_act, f_res = whitecap_cover(wf, Xv, Yv, t_s, fv, smp["crest"], var_r, wf.crest_variance()[:, None],
@@ -489,6 +530,22 @@ class TextureTable:
         upper = F.grid_sample(vol, grid.permute(0, 2, 3, 1), mode="bilinear", padding_mode="border", align_corners=True)
         del grid
         return torch.lerp(read, upper, fz[:, None]) if read.requires_grad or fz.requires_grad else read.lerp_(upper, fz[:, None])
+
+
+def _across_quantile(slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple, dx: torch.Tensor, dy: torch.Tensor,
+                     x: torch.Tensor) -> torch.Tensor:
+    """y = c_r/σ_r: the resolved slope's component across the line of sight (ê⊥ = ê turned +90°, ê = −(dx,
+    dy) the unit horizontal direction towards the sensor) less its regression κ_r a on the along-view
+    slope a = x σ_a, over the residual's rms σ_r; clamped to ±3.5 (the quadratic in y is fitted at ±√3); 0
+    where σ_r² ≤ 1e-12 σ_a² (nothing resolved across)."""
+    ex, ey = -dx, -dy
+    var_a, kap = along_view(cov, ex, ey)
+    var_p, _ = along_view(cov, -ey, ex)
+    var_r = var_p - kap * kap * var_a
+    ok = var_r > 1e-12 * (var_a + var_p).clamp_min(1e-30)
+    c_r = slope_x * (-ey) + slope_y * ex - kap * x * var_a.clamp_min(0.0).sqrt()
+    y = c_r * torch.rsqrt(torch.where(ok, var_r, torch.ones_like(var_r)))
+    return torch.where(ok, y.clamp(-3.5, 3.5), torch.zeros_like(y))
 
 
 def sky_of_chunk(sky: Any, b: int) -> Any:
