@@ -538,12 +538,17 @@ def _across_quantile(slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple, d
     dy) the unit horizontal direction towards the sensor) less its regression κ_r a on the along-view
     slope a = x σ_a, over the residual's rms σ_r; clamped to ±3.5 (the quadratic in y is fitted at ±√3); 0
     where σ_r² ≤ 1e-12 σ_a² (nothing resolved across)."""
+    cxx, cyy, cxy = cov
     ex, ey = -dx, -dy
-    var_a, kap = along_view(cov, ex, ey)
-    var_p, _ = along_view(cov, -ey, ex)
-    var_r = var_p - kap * kap * var_a
-    ok = var_r > 1e-12 * (var_a + var_p).clamp_min(1e-30)
-    c_r = slope_x * (-ey) + slope_y * ex - kap * x * var_a.clamp_min(0.0).sqrt()
+    exy, exx, eyy = ex * ey, ex * ex, ey * ey
+    var_a = cxx * exx + 2.0 * cxy * exy + cyy * eyy
+    cov_ap = (cyy - cxx) * exy + cxy * (exx - eyy)  # (:func:`~roughsea_torch.clutter.along_view`'s κ_r σ_a²)
+    var_p = cxx * eyy - 2.0 * cxy * exy + cyy * exx
+    ok_a = var_a > 1e-30
+    inv_a = torch.where(ok_a, var_a, torch.ones_like(var_a)).reciprocal()
+    var_r = var_p - cov_ap * cov_ap * inv_a
+    ok = ok_a & (var_r > 1e-12 * (var_a + var_p))
+    c_r = slope_y * ex - slope_x * ey - cov_ap * x * inv_a.sqrt()
     y = c_r * torch.rsqrt(torch.where(ok, var_r, torch.ones_like(var_r)))
     return torch.where(ok, y.clamp(-3.5, 3.5), torch.zeros_like(y))
 
