@@ -45,7 +45,7 @@ import torch
 from ._parallel import map_chunks
 from ._validation import as_tensor, check_finite_range, check_same_device
 from .atmosphere import as_sky
-from .facets import FacetGeometry, denominator, facet_geometry, normal_cdf, normal_pdf, prepare_inputs
+from .facets import FacetGeometry, denominator, facet_geometry, normal_cdf, normal_pdf, prepare_inputs, visible_ratio
 from .foam import foam_radiance, foam_sky_radiance, with_foam
 from .masking import check_shadowing, masked_denominator, masking_ratio, view_nu
 from .optics import fresnel_terms, split_refractive_index
@@ -275,7 +275,8 @@ def _sky_terms(
         def one(sel: torch.Tensor, split: bool = split) -> tuple[torch.Tensor, torch.Tensor]:
             i_s, i_r = _sky_numerator(g.take(sel), n[sel], k[sel], _sky_chunk(sky_fn, shape, sel, device), q, split,
                                       masking, shadowing)
-            return i_s / D[sel], i_r / D[sel]
+            ratio = visible_ratio if shadowing else torch.div  # (Eq. 7's D = e may be negative: as it is)
+            return ratio(i_s, D[sel]), ratio(i_r, D[sel])
 
         # chunks on worker threads of one intra-op thread each (roughsea_torch._parallel)
         parts = map_chunks(one, [idx[i : i + step] for i in range(0, idx.numel(), step)], device)
@@ -405,7 +406,8 @@ def emissivity(
     points = q.outer * q.hermite * (1 if shadowing else 2)
 
     def one(sl: slice) -> torch.Tensor:
-        return (_emissivity_numerator(g.take(sl), nf[sl], kf[sl], shadowing, q) / D[sl]).to(dtype)
+        ratio = visible_ratio if shadowing else torch.div  # (Eq. 7's D = e may be negative: as it is)
+        return ratio(_emissivity_numerator(g.take(sl), nf[sl], kf[sl], shadowing, q), D[sl]).to(dtype)
 
     return _run_chunked(shape, points, q, one, dtype, device)
 

@@ -33,7 +33,7 @@ import torch
 from ._validation import as_tensor, check_finite_range, resolve_dtype_device
 from .slopes import SlopeStatistics
 
-__all__ = ["FacetGeometry", "facet_geometry", "denominator", "prepare_inputs", "normal_pdf", "normal_cdf"]
+__all__ = ["FacetGeometry", "facet_geometry", "denominator", "prepare_inputs", "normal_pdf", "normal_cdf", "visible_ratio"]
 
 _INV_SQRT_2PI = 1.0 / math.sqrt(2.0 * math.pi)
 _SQRT_HALF = math.sqrt(0.5)
@@ -133,6 +133,16 @@ def denominator(g: FacetGeometry, shadowing: bool) -> torch.Tensor:
     mu = e / torch.where(big, torch.ones_like(a), a)
     mu = torch.where(big, torch.full_like(mu, 40.0), mu)
     return torch.where(big, e, e * normal_cdf(mu) + a * normal_pdf(mu))
+
+
+def visible_ratio(numerator: torch.Tensor, D: torch.Tensor) -> torch.Tensor:
+    """numerator / D, the facet-weighted mean of Eq. 5, and 0 where D ≤ the dtype's smallest normal number:
+    where the mean slope turns every facet of the window away from the sensor (a resolved tilt of the
+    texture's outer nodes near grazing, D = 0 or underflowing), the limit of the visible facets' terms.
+    Those facets are seen at grazing local incidence: their emissivity and their reflected rays into the
+    sky vanish (ρ → 1, the mirrored ray runs on into the sea), so R_a → R_B; 0/0 gave NaN there."""
+    ok = D > torch.finfo(D.dtype).tiny
+    return torch.where(ok, numerator / torch.where(ok, D, torch.ones_like(D)), torch.zeros_like(numerator))
 
 
 def _check_angles(view_zenith: Any, view_azimuth: Any) -> None:

@@ -36,7 +36,7 @@ from typing import Any
 import torch
 
 from ._validation import as_tensor, check_finite_range
-from .facets import denominator, facet_geometry, prepare_inputs
+from .facets import denominator, facet_geometry, prepare_inputs, visible_ratio
 from .optics import fresnel_terms, split_refractive_index
 from .quadrature import gauss_nodes
 
@@ -314,11 +314,12 @@ def glint_from_moments(vz: torch.Tensor, va: torch.Tensor, vx: torch.Tensor, vy:
         mx = my = zero
     D = denominator(facet_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
     l_sun = e_sun / (4.0 * math.pi * torch.sin(0.5 * alpha) ** 2)  # Ω_sun = 2π(1 − cos α), without cancellation
+    ratio = visible_ratio if shadowing else torch.div  # (Eq. 7's D = e may be negative: as it is)
     if smooth:
-        return torch.where(torch.cos(tz) > 0, l_sun / D, zero)
+        return torch.where(torch.cos(tz) > 0, ratio(l_sun, D), zero)
     sharp, above = glint_sharp_factor(torch.cos(vz), torch.sin(vz), torch.cos(va), torch.sin(va), vx, vy, cxy, mx, my,
                                       n, k, tz, tp, alpha)
-    return torch.where(above, sharp * l_sun / D, zero)
+    return torch.where(above, ratio(sharp * l_sun, D), zero)
 
 
 def sun_masking_factor(slopes: Any, sun: Sun, dtype: torch.dtype = torch.float64, device: Any = None) -> torch.Tensor:

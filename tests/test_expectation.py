@@ -853,3 +853,25 @@ def test_black_sky_is_the_affine_end_of_eq_10():
         assert bool((ra(0.0) >= 30.0 * eps * (1 - 1e-8)).all())  # two quadratures, each within 1e-8
         if slopes.corr == 0.0:  # 3 m/s: no facet steep enough to send a ray into the sea near nadir
             torch.testing.assert_close(ra(0.0)[:4], 30.0 * eps[:4], rtol=1e-8, atol=0)  # θ̂ ≤ 9°
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+@pytest.mark.parametrize("shadowing", [True, "correlated"])
+@pytest.mark.parametrize("tilt", [-0.7, -1.5, -4.0])
+def test_mean_tilt_turning_every_facet_away_gives_the_sea_radiance(dtype, shadowing, tilt):
+    """A shifted mean slope that turns every facet of the quadrature's window away from a view at 87.4° (the
+    outer nodes of a textured render's along-view slope: x = −4.5 σ_a at fine footprints) leaves D of Eq. 5
+    (or the correlated masking's D_Q) 0 or underflowing. The limit of what stays visible is facets seen at
+    grazing local incidence, whose emission vanishes and whose mirrored rays run on into the sea: R_a = R_B,
+    ε̄ = 0, and a finite gradient. It was 0/0 = NaN (correlated from tilt −0.7, Eq. 5 in float32 from −1.5),
+    which the texture volume's spectral resampling spread over a whole image."""
+    th = torch.acos(torch.tensor(0.04466, dtype=dtype))
+    m = torch.tensor(tilt, dtype=dtype, requires_grad=True)
+    st = rs.SlopeStatistics.from_variances(torch.tensor(0.00685, dtype=dtype), torch.tensor(0.0126, dtype=dtype),
+                                           torch.tensor(0.0, dtype=dtype)).shifted(m, torch.tensor(0.0, dtype=dtype))
+    zero = torch.tensor(0.0, dtype=dtype)
+    r = rs.apparent_radiance(th, zero, st, sea_radiance=2.0, sky=lambda mu: 1.5 + 0 * mu, shadowing=shadowing)
+    eps = rs.emissivity(th, zero, st, shadowing=shadowing)
+    (g,) = torch.autograd.grad(r, m)
+    assert float(r.detach()) == pytest.approx(2.0, abs=1e-6) and float(eps.detach()) == pytest.approx(0.0, abs=1e-6)
+    assert bool(torch.isfinite(g))
