@@ -12,9 +12,11 @@ float32 rounding: ~1e-4 K for expectation images, up to ~1e-3–1e-2 K for textu
 0.02 K max or below 0.999 correlation is flagged ``<<``. The gradient cases compare d(mean T)/d(wind
 speed) by autograd (also on the float64 rule) and its per-pixel map (``rs.pixel_derivative``).
 
-    PYTHONPATH=. python pipelines/dtype_agreement.py [--only SUBSTRING]
+    PYTHONPATH=. python pipelines/dtype_agreement.py [--only SUBSTRING] [--random N]
 
-Small cameras (48×64 to 128×160), one thread; about a minute. Report: ``docs/dtype_agreement.md``.
+and N (default 48) scenes drawn at random, compared on the float64 rule (flagged only beyond 0.02 K
+and three times the float64 render's own change for the pitch step). Small cameras (48×64 to
+128×160), one thread; about two minutes. Report: ``docs/dtype_agreement.md``.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import random
 import sys
 import time
 
@@ -235,6 +238,26 @@ def gradient_cases():
             ("dT/dW, 8 m/s, seed 11, first", gradient_case(8.0, 11, table=rs.TableSize(texture_hit="first"), **sea))]
 
 
+def random_scenes(n: int, seed: int = 7):
+    """``n`` scenes drawn at random (Python's ``random``, fixed seed): wind, direction (cardinal or any),
+    pitch, altitude, yaw, time up to 2e8 s, wave seed, sun or night, flat or first hit, foam trails."""
+    rng = random.Random(seed)
+    for _ in range(n):
+        wind, wd = rng.choice([1.5, 4.0, 8.0, 12.0, 18.0, 24.0]), rng.choice([0.0, PI / 2, PI, -PI / 2, rng.uniform(-3, 3)])
+        cam_kw = dict(h=48, w=64, hfov=25.0, pitch=rng.choice([-0.5, -2.0, -5.0, -12.0, -30.0]),
+                      alt=rng.choice([3.0, 10.0, 30.0, 100.0]), yaw=rng.uniform(-180, 180))
+        t, wave_seed = rng.choice([0.0, 2.7, 1e4 + 0.1, 3e6 + 0.7, 2e8 + 0.3]), rng.randrange(1000)
+        sun, first, trails = rng.random() < 0.4, rng.random() < 0.5, rng.random() < 0.3
+        kw = dict(wind_speed=wind, wind_direction=wd, sea_temperature=290.0, seed=wave_seed, time_s=t)
+        if sun:
+            kw.update(band=rs.MWIR, sun_zenith=rng.uniform(0.9, 1.45), sun_azimuth=rng.uniform(-3, 3))
+        table = rs.TableSize(texture_hit="first" if first else "flat", foam_trails=trails)
+        name = (f"{wind:g} m/s, dir {wd:.3f}, pitch {cam_kw['pitch']:g}°, {cam_kw['alt']:g} m, yaw {cam_kw['yaw']:.0f}°, "
+                f"t {t:g} s, seed {wave_seed}, {'sun' if sun else 'night'}, {'first' if first else 'flat'}"
+                + (", trails" if trails else ""))
+        yield name, still(cam_kw=cam_kw, table=table, **kw)
+
+
 def fmt_corr(c: float) -> str:
     return "—" if math.isnan(c) else f"{c:.6f}"
 
@@ -242,6 +265,7 @@ def fmt_corr(c: float) -> str:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--only", default="", help="run only the cases whose name contains this")
+    ap.add_argument("--random", type=int, default=48, help="scenes drawn at random after the listed ones (0: none)")
     args = ap.parse_args()
     t_start = time.time()
     print(f"# torch {torch.__version__}, roughsea_torch {rs.__version__}, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")
@@ -278,6 +302,18 @@ def main() -> None:
         finite = bool(torch.isfinite(p32).all() and torch.isfinite(p64).all())
         print(f"| {name} | {g64:.5f} | {g32 - g64:+.1e} | {g32q - g64:+.1e} | {float(d.max()):.2e} | {float(d.pow(2).mean().sqrt()):.2e} | "
               f"{corr:.6f} | {time.time() - t0:.1f} |" + ("" if finite else " non-finite << |"), flush=True)
+    if args.random:
+        print()
+        print(f"| random scene (on the f64 rule) | max \\|T32 − T64\\| [K] | rms [K] | clutter corr. | max, f64 at pitch + 1e-6° [K] |")
+        print("|---|---|---|---|---|")
+        for name, run in random_scenes(args.random):
+            t64 = run(torch.float64)
+            mx, rms, corr = stats(run(torch.float32, Q64), t64)
+            mx_c = stats(run(torch.float64, dpitch=DPITCH_DEG), t64)[0]
+            bad = (mx > FLAG_MAX_K and mx > 3 * mx_c) or (not math.isnan(corr) and corr < FLAG_CORR)
+            if bad:
+                flagged.append(name)
+            print(f"| {name} | {mx:.2e} | {rms:.2e} | {fmt_corr(corr)} | {mx_c:.2e} |" + (" << |" if bad else ""), flush=True)
     print()
     print(f"flagged (max > {FLAG_MAX_K} K or corr < {FLAG_CORR}): {flagged if flagged else 'none'}")
     print(f"total {time.time() - t_start:.0f} s")
