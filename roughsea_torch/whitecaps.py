@@ -276,18 +276,21 @@ def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tens
     dtype = x.dtype
     extra = (None,) * (x.ndim - 1)
     a = active_share(wf.wind_speed, wf.inverse_wave_age, decay_s).to(dtype)[(...,) + extra]
-    vx, vy = (v.to(dtype)[(...,) + extra] for v in foam_drift(wf.wind_speed, wf.wind_direction))
+    # the drift in float64 whatever the dtype: it moves the streak field by v t, which at large t (1e5–1e9 s)
+    # is far more than a streak is wide, so a velocity or direction rounded to float32 would draw other streaks
+    vx64, vy64 = foam_drift(wf.wind_speed.double(), wf.wind_direction.double())
+    vx, vy = (v.to(dtype)[(...,) + extra] for v in (vx64, vy64))
     epochs, weights = deposit_epochs(time_s, decay_s)
 
     # the fine structure: X + s ν, ν the drifting streak field (foam_streaks), s² = κ σ_X², of which the
     # footprint keeps the share r; the variances given to the threshold are the sum's, so E[B] = W stays exact
-    v_norm = torch.sqrt(vx * vx + vy * vy).clamp_min(1e-30)
+    v_norm = torch.sqrt(vx64 * vx64 + vy64 * vy64).clamp_min(1e-30)
     along, across = streak_lengths(wf.wind_speed)
-    t_now = time_s[(...,) + extra]  # the drifting frame in float64 (times and positions may be large)
+    t_now = time_s.double()[(...,) + extra]  # the drifting frame in float64 (times and positions may be large)
     root_r = resolved_amplitude(footprint, across.to(dtype)[(...,) + extra])  # √r, r the share the footprint keeps
     keep = None if footprint is None else (root_r.detach() > 0).expand(x.shape)
-    nu = streak_noise(x.double() - vx.double() * t_now, y.double() - vy.double() * t_now, wf.seeds,
-                      (vx / v_norm).reshape(-1), (vy / v_norm).reshape(-1), along, across, where=keep).to(dtype)
+    nu = streak_noise(x.double() - vx64[(...,) + extra] * t_now, y.double() - vy64[(...,) + extra] * t_now, wf.seeds,
+                      vx64 / v_norm, vy64 / v_norm, along, across, where=keep).to(dtype)
     s2 = STREAK_VARIANCE_SHARE * total_variance
     lift = root_r * torch.sqrt(s2.clamp_min(1e-30)) * nu
     r = root_r * root_r

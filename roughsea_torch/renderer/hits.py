@@ -164,7 +164,7 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     r_end = math.sqrt(max(l_end * hf / (ifov * 2.0 * min_step) - hf * hf, 0.0))  # the finest sample's reach
     tg = tan_g.detach()
     tg_max, tg_min = float(tg.max()), float(tg.min())
-    sig = float(field.elevation_variance(torch.tensor(2.0 * min_step * ifov * hf, dtype=torch.float64))[image].sqrt())
+    sig = float(field.elevation_variance(torch.tensor(2.0 * min_step * ifov * hf, dtype=torch.float64))[image].detach().sqrt())
     eta_max = height_sigmas * sig
     r0 = max(0.05, (hf - eta_max) / tg_max) if hf > eta_max else 0.05
     r1 = min(r_end, 1.2 * hf / max(tg_min, 1e-9) + eta_max / max(tg_min, 1e-9))
