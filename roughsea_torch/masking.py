@@ -14,7 +14,7 @@ conditioned on the origin's height ξ₀ and slope γ₀ (γ = −s∥ along the
 
 for a Gaussian height autocorrelation R(l) = σ_h² exp(−l²/L²). In units σ_h = L = 1 it depends only on
 ν = (cot θ̂ + m∥)/σ∥ (the line of sight's slope over the rms slope along it, with a mean slope m∥)
-and x = (s∥ − m∥)/σ∥, so Q is tabulated once (float64, on first use, :func:`masking_table`) on
+and x = (s∥ − m∥)/σ∥, so Q is tabulated (float64, shipped with the package: :func:`masking_table`) on
 √(x + ν) ∈ [0, 4] × ln ν ∈ [ln 0.01, ln 8] and interpolated bilinearly. The option's facet weight is
 t(s) Q, normalized by D_Q = E[t Q H(t)] (:func:`masked_denominator`); Q ≡ 1 would be Eq. 5 exactly.
 Outside the table: ν < 0.01 (within ~0.1° of grazing) uses ν = 0.01, ν > 8 (no masking left) uses
@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -35,7 +36,8 @@ import torch
 
 from .facets import FacetGeometry, normal_cdf, normal_pdf
 
-__all__ = ["SHADOWING_OPTIONS", "check_shadowing", "masking_table", "masking_ratio", "masked_denominator"]
+__all__ = ["SHADOWING_OPTIONS", "check_shadowing", "masking_table", "compute_masking_table", "table_nodes", "masking_ratio",
+           "masked_denominator", "TABLE_FILE"]
 
 SHADOWING_OPTIONS = (True, False, "correlated")
 NU_MIN, NU_MAX, W_MAX = 0.01, 8.0, 16.0
@@ -99,24 +101,47 @@ def _exponent(xi0: torch.Tensor, g0: torch.Tensor, mu: torch.Tensor, lam: torch.
     return inner + tail
 
 
+TABLE_FILE = Path(__file__).resolve().parent / "data" / "masking" / "masking_table.npz"
+
+
+def table_nodes() -> tuple[torch.Tensor, torch.Tensor]:
+    """(p nodes, ln ν nodes) of the table, float64: p = √(x + ν) on [0, √W_MAX], ln ν on [ln NU_MIN, ln NU_MAX]."""
+    return (torch.linspace(0.0, math.sqrt(W_MAX), _N_P, dtype=torch.float64),
+            torch.linspace(math.log(NU_MIN), math.log(NU_MAX), _N_NU, dtype=torch.float64))
+
+
 @lru_cache(maxsize=1)
 def masking_table() -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """(p nodes, ln ν nodes, Q[p, ν]) in float64 on the CPU, p = √(x + ν); computed once (~seconds)."""
-    p = torch.linspace(0.0, math.sqrt(W_MAX), _N_P, dtype=torch.float64)
-    ln_nu = torch.linspace(math.log(NU_MIN), math.log(NU_MAX), _N_NU, dtype=torch.float64)
+    """(p nodes, ln ν nodes, Q[p, ν]) in float64 on the CPU, p = √(x + ν): the table shipped in
+    ``data/masking/masking_table.npz`` (written by ``pipelines/make_masking_table.py`` from
+    :func:`compute_masking_table`), or computed here (~10 s) if that file is missing or was made on other
+    nodes."""
+    p, ln_nu = table_nodes()
+    if TABLE_FILE.is_file():
+        with np.load(TABLE_FILE) as f:
+            if (f["p"].shape == p.shape and f["ln_nu"].shape == ln_nu.shape and np.array_equal(f["p"], p.numpy())
+                    and np.array_equal(f["ln_nu"], ln_nu.numpy())):
+                return p, ln_nu, torch.from_numpy(f["q"].copy())
+    return compute_masking_table()
+
+
+def compute_masking_table(rows: Any = None) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """(p nodes, ln ν nodes, Q[p, ν]) computed from the module docstring's integrals (float64, CPU, ~10 s);
+    ``rows``: only these indices of the ν nodes (Q then holds those columns), e.g. to check the shipped table."""
+    p, ln_nu = table_nodes()
     xi0, wxi = _gl(96, -8.5, 8.5)
     wxi = wxi * normal_pdf(xi0)
     nu = torch.exp(ln_nu)
     lam = _lambda(nu)
     mu = nu * _SIGMA
-    rows = []
-    for j in range(_N_NU):
+    out = []
+    for j in (range(_N_NU) if rows is None else rows):
         w = p * p
         g0 = -(w.clamp_min(W_MIN) - nu[j]) * _SIGMA  # γ₀ = −σ x, x = w − ν; held below W_MIN
         ex = _exponent(xi0[None, :], g0[:, None], mu[j].expand(1, 1), lam[j].expand(1, 1, 1))
         s = (torch.exp(-ex) * wxi).sum(-1)
-        rows.append(s * (1.0 + lam[j]))
-    return p, ln_nu, torch.stack(rows, dim=1)
+        out.append(s * (1.0 + lam[j]))
+    return p, ln_nu, torch.stack(out, dim=1)
 
 
 def masking_ratio(x: torch.Tensor, nu: torch.Tensor) -> torch.Tensor:

@@ -190,3 +190,18 @@ def test_projected_area_refuses_correlated():
         rs.projected_area(1.4, 0.0, rs.SlopeStatistics.cox_munk(5.0), shadowing="correlated")
     with pytest.raises(ValueError, match="shadowing"):
         ref.projected_area(1.4, 0.0, ref.SlopeStatistics.cox_munk(5.0), shadowing="correlated")
+
+
+def test_shipped_table_is_the_computed_one():
+    """The correlated masking table ships with the package (``data/masking/masking_table.npz``, made by
+    ``pipelines/make_masking_table.py``; computing it took ~10 s on every process's first correlated
+    render): :func:`masking.masking_table` reads it, on the nodes the module defines, and three of its ν
+    columns (the first, middle and last) equal a fresh computation of the integrals to 1e-12. A stale or
+    damaged file (other nodes, other values) fails here."""
+    assert masking.TABLE_FILE.is_file()
+    p, ln_nu, q = masking.masking_table()
+    p0, ln0 = masking.table_nodes()
+    assert torch.equal(p, p0) and torch.equal(ln_nu, ln0)
+    cols = [0, ln_nu.numel() // 2, ln_nu.numel() - 1]
+    _, _, fresh = masking.compute_masking_table(rows=cols)
+    assert float((q[:, cols] - fresh).abs().max()) < 1e-12
