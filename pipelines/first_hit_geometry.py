@@ -66,7 +66,7 @@ H, W, HFOV, PITCH, T_SEA, SEED, TIME_S = 48, 64, 12.0, -6.0, 290.0, 11, 3.0
 DIRECTIONS = {"upwind": (15.0, 0.0), "crosswind": (20.0, math.pi / 2)}
 QUAD = Quadrature(outer=20, inner=20, hermite=12, width=7.5)  # the ray tracer's rule
 K_TRACED = 64.0
-DEFAULT = dict(step=0.25, min_step=1 / 32, across=1.0)  # TableSize's first-hit defaults
+DEFAULT = dict(step=0.25, min_step=1 / 32, across=1.0)  # TableSize's first-hit defaults until 2026-11-27 (now 1/64, 0.7)
 INF = float("inf")
 F64 = torch.float64
 

@@ -13,8 +13,8 @@ import torch
 
 import roughsea_torch as rs
 from roughsea_torch.renderer.antialias import FOAM_TAPS, filter_columns
-from roughsea_torch.clutter import footprint
-from roughsea_torch.renderer.texture import TextureTable
+from roughsea_torch.clutter import along_view, footprint, two_scale_statistics
+from roughsea_torch.renderer.texture import TextureTable, _across_quantile
 from roughsea_torch.whitecaps import whitecap_cover
 
 from conftest import horizon_sky, make_cams, make_scene, torch_threads
@@ -391,3 +391,69 @@ def test_textured_table_matches_per_pixel_evaluation_with_an_air_temperature():
     assert float(amp / mean.max()) > 3e-3
     assert float(err.max()) < 0.015 * float(amp)
     assert float(err.max() / direct.max()) < 3e-4
+
+
+def _across_view_basis(phi, cov_world, wind_direction):
+    """Independently of the renderer: ê = (cos φ, sin φ), ê⊥ = ê turned +90°, and the resolved covariance C
+    in that frame's axes (rotated by −wind_direction from the world), with σ_a² = êᵀCê, κ_r = ê⊥ᵀCê/σ_a² and
+    the residual variance σ_r² = ê⊥ᵀCê⊥ − κ_r² σ_a² of the across-view slope given the along-view one."""
+    c, s = math.cos(wind_direction), math.sin(wind_direction)
+    rot = torch.tensor([[c, s], [-s, c]], dtype=torch.float64)
+    C = rot @ cov_world @ rot.T
+    e = torch.tensor([math.cos(phi), math.sin(phi)], dtype=torch.float64)
+    ep = torch.tensor([-math.sin(phi), math.cos(phi)], dtype=torch.float64)
+    var_a = e @ C @ e
+    kap = (ep @ C @ e) / var_a
+    return C, e, ep, var_a, kap, ep @ C @ ep - kap * kap * var_a
+
+
+@pytest.mark.parametrize("phi_hat", [1.2, -0.9, 2.5])
+def test_across_view_columns_put_the_resolved_residual_into_the_mean(phi_hat):
+    """The first hit's across-view columns (TableSize.texture_hit_cross): at y = ±√3 the unresolved Gaussian
+    is N(a (ê + κ_r ê⊥) + y σ_r ê⊥, Σ − C) exactly (Σ the total, C the resolved covariance: the residual
+    c_r = y σ_r leaves the covariance and enters the mean, ê⊥ = ê turned +90°, ê the line of sight
+    sea → sensor at φ̂ from upwind), built here from the closed form in the (ê, ê⊥) basis. Planted, ê⊥ with
+    the other sign in ``_cross_columns``: the means miss by 2√3 σ_r ≈ 0.3 in slope, and the test fails."""
+    D = torch.float64
+    t = lambda v: torch.tensor(v, dtype=D)  # noqa: E731
+    vx, vy, cxy, wd = t(0.0190), t(0.0140), t(0.0015), 0.4
+    cov_world = torch.tensor([[0.0060, 0.0025], [0.0025, 0.0080]], dtype=D)
+    C, e, ep, var_a, kap, var_r = _across_view_basis(phi_hat, cov_world, wd)
+    ph, phw = t([phi_hat]), t([[phi_hat + wd]])
+    cov = tuple(v.reshape(1, 1, 1) for v in (cov_world[0, 0], cov_world[1, 1], cov_world[0, 1]))
+    va, kp = along_view(cov, torch.cos(phw)[:, None, :], torch.sin(phw)[:, None, :])  # (1, 1, 1)
+    x = t([[0.7]])
+    st = two_scale_statistics(vx, vy, cxy, ph, t([0.1]), x, va.reshape(1), kp.reshape(1), visible=x)
+    moments = [torch.as_tensor(m, dtype=D).expand(1, 1) for m in (st.var_upwind, st.var_crosswind, st.cov,
+                                                                   st.mean_upwind, st.mean_crosswind)]
+    moments = [torch.cat([m, m], 1) for m in moments]  # the x column and the expectation's (unused here)
+    out = TextureTable._cross_columns(moments, cov, phw, va, kp, lambda v: v.reshape(1), ph, 1)
+    su = torch.tensor([[vx, cxy], [cxy, vy]], dtype=D) - C
+    a = 0.7 * var_a.sqrt()
+    for col, y in ((2, -math.sqrt(3.0)), (3, math.sqrt(3.0))):
+        mean = a * (e + kap * ep) + y * var_r.sqrt() * ep
+        got = [float(m[0, col]) for m in out]
+        want = [float(su[0, 0]), float(su[1, 1]), float(su[0, 1]), float(mean[0]), float(mean[1])]
+        assert got == pytest.approx(want, abs=1e-12), (col, got, want)
+    assert float(torch.linalg.eigvalsh(su).min()) > 0  # the unresolved law stays a proper Gaussian
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+def test_across_quantile_reads_the_residual_of_a_constructed_slope(dtype):
+    """y = c_r/σ_r at the sweep's samples: a resolved slope built as s = a ê + (κ_r a + y σ_r) ê⊥ (ê = −(dx, dy)
+    the horizontal direction towards the sensor, ê⊥ = ê turned +90°, a = x σ_a; κ_r, σ_r from the resolved
+    covariance in closed form) gives back y, whatever the length of (dx, dy). Planted: y with the other sign
+    (ê⊥ turned −90°), or the regression κ_r a left in c_r: fails."""
+    wd = 0.0  # the sample's world frame is its own
+    cov_world = torch.tensor([[0.0060, 0.0025], [0.0025, 0.0080]], dtype=torch.float64)
+    for az in (0.3, 2.0, -2.6):
+        C, e, ep, var_a, kap, var_r = _across_view_basis(az + math.pi, cov_world, wd)  # ê = −(cos az, sin az)
+        y = torch.linspace(-3.0, 3.0, 13, dtype=torch.float64)
+        x = torch.linspace(-2.0, 2.5, 13, dtype=torch.float64).flip(0)
+        a = x * var_a.sqrt()
+        s = a[:, None] * e + (kap * a + y * var_r.sqrt())[:, None] * ep
+        d = torch.tensor([math.cos(az), math.sin(az)], dtype=torch.float64) * 2.5  # camera → sea, not unit
+        got = _across_quantile(s[:, 0].to(dtype), s[:, 1].to(dtype), tuple(v.to(dtype) for v in (C[0, 0], C[1, 1], C[0, 1])),
+                               d[0].to(dtype), d[1].to(dtype), x.to(dtype))
+        tol = 1e-10 if dtype == torch.float64 else 1e-4
+        torch.testing.assert_close(got.double(), y, rtol=0, atol=tol)
