@@ -140,7 +140,12 @@ def visible_ratio(numerator: torch.Tensor, D: torch.Tensor) -> torch.Tensor:
     where the mean slope turns every facet of the window away from the sensor (a resolved tilt of the
     texture's outer nodes near grazing, D = 0 or underflowing), the limit of the visible facets' terms.
     Those facets are seen at grazing local incidence: their emissivity and their reflected rays into the
-    sky vanish (ρ → 1, the mirrored ray runs on into the sea), so R_a → R_B; 0/0 gave NaN there."""
+    sky vanish (ρ → 1, the mirrored ray runs on into the sea), so R_a → R_B; 0/0 gave NaN there. The
+    expectation's quadrature window (±``Quadrature.width`` σ about the mean) reaches R_B early: once the
+    visible facets lie beyond it (at 87.4°, rms 0.083, from a tilt of about −0.65) its numerators are 0,
+    while a window reaching them gives R_a = 0.933 R_B at −0.7 and 0.9975 R_B at −2 (sky 0.75 R_B). Only
+    the texture's outer nodes reach such tilts (≤ 1.2 mK in first-hit renders); starting the window at
+    the visibility edge would remove it."""
     ok = D > torch.finfo(D.dtype).tiny
     return torch.where(ok, numerator / torch.where(ok, D, torch.ones_like(D)), torch.zeros_like(numerator))
 

@@ -857,21 +857,28 @@ def test_black_sky_is_the_affine_end_of_eq_10():
 
 @pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
 @pytest.mark.parametrize("shadowing", [True, "correlated"])
-@pytest.mark.parametrize("tilt", [-0.7, -1.5, -4.0])
-def test_mean_tilt_turning_every_facet_away_gives_the_sea_radiance(dtype, shadowing, tilt):
-    """A shifted mean slope that turns every facet of the quadrature's window away from a view at 87.4° (the
-    outer nodes of a textured render's along-view slope: x = −4.5 σ_a at fine footprints) leaves D of Eq. 5
-    (or the correlated masking's D_Q) 0 or underflowing. The limit of what stays visible is facets seen at
-    grazing local incidence, whose emission vanishes and whose mirrored rays run on into the sea: R_a = R_B,
-    ε̄ = 0, and a finite gradient. It was 0/0 = NaN (correlated from tilt −0.7, Eq. 5 in float32 from −1.5),
-    which the texture volume's spectral resampling spread over a whole image."""
+def test_mean_tilt_turning_every_facet_away_approaches_the_sea_radiance(dtype, shadowing):
+    """A shifted mean slope that turns more and more of the facets away from a view at 87.4° (the outer nodes
+    of a textured render's along-view slope: x = −4.5 σ_a at fine footprints). What stays visible is seen at
+    grazing local incidence: its emission vanishes and its mirrored rays run on into the sea, so R_a → R_B
+    (2 here) and ε̄ → 0, monotonically, with finite values and gradients all the way. Where the visible
+    facets leave the quadrature's Gaussian window (±7.5σ in float64, ±6σ in float32) D of Eq. 5 underflows
+    (float32 from a tilt of −1.5) and the correlated masking's D_Q is exactly 0: this was 0/0 = NaN, which the
+    texture volume's spectral resampling spread over a whole image. The window's truncation itself makes
+    R_a reach R_B early (at −0.7: 2.0 where a window reaching the visible facets gives 1.866): a known
+    approximation, ≤ 1.2 mK in first-hit renders (``facets.visible_ratio``)."""
     th = torch.acos(torch.tensor(0.04466, dtype=dtype))
-    m = torch.tensor(tilt, dtype=dtype, requires_grad=True)
-    st = rs.SlopeStatistics.from_variances(torch.tensor(0.00685, dtype=dtype), torch.tensor(0.0126, dtype=dtype),
-                                           torch.tensor(0.0, dtype=dtype)).shifted(m, torch.tensor(0.0, dtype=dtype))
     zero = torch.tensor(0.0, dtype=dtype)
-    r = rs.apparent_radiance(th, zero, st, sea_radiance=2.0, sky=lambda mu: 1.5 + 0 * mu, shadowing=shadowing)
-    eps = rs.emissivity(th, zero, st, shadowing=shadowing)
-    (g,) = torch.autograd.grad(r, m)
-    assert float(r.detach()) == pytest.approx(2.0, abs=1e-6) and float(eps.detach()) == pytest.approx(0.0, abs=1e-6)
-    assert bool(torch.isfinite(g))
+    prev_r, prev_e = -math.inf, math.inf
+    for tilt in (-0.3, -0.5, -0.7, -1.5, -4.0):
+        m = torch.tensor(tilt, dtype=dtype, requires_grad=True)
+        st = rs.SlopeStatistics.from_variances(torch.tensor(0.00685, dtype=dtype), torch.tensor(0.0126, dtype=dtype),
+                                               zero).shifted(m, zero)
+        r = rs.apparent_radiance(th, zero, st, sea_radiance=2.0, sky=lambda mu: 1.5 + 0 * mu, shadowing=shadowing)
+        eps = rs.emissivity(th, zero, st, shadowing=shadowing)
+        (g,) = torch.autograd.grad(r, m)
+        rv, ev = float(r.detach()), float(eps.detach())
+        assert math.isfinite(rv) and math.isfinite(ev) and bool(torch.isfinite(g)), (tilt, rv, ev, g)
+        assert prev_r - 1e-5 <= rv <= 2.0 + 1e-6 and -1e-6 <= ev <= prev_e + 1e-5, (tilt, rv, ev)
+        prev_r, prev_e = rv, ev
+    assert prev_r == pytest.approx(2.0, abs=5e-3) and prev_e == pytest.approx(0.0, abs=5e-3)
