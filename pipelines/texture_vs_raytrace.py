@@ -519,7 +519,7 @@ def report(args, cases, ens, spec, ident, timings, command, date) -> str:
         f"{args.load[1]:.1f} at the end: the machine's {os.cpu_count()} cores were shared, so the run times below "
         "vary with the other jobs).",
         "",
-        "Scene: `rs.SeaScene(wind_speed=W, wind_direction=..., sea_temperature=290, seed=11, time_s=3.0, foam=False, "
+        f"Scene: `rs.SeaScene(wind_speed=W, wind_direction=..., sea_temperature=290, seed={SEED}, time_s={TIME_S:g}, foam=False, "
         f"path=False{', shadowing=' + repr(SHADOWING) if SHADOWING is not True else ''})` (textured side), LWIR 8–12 µm, LOWTRAN7 midlatitude-summer sky, anisotropic Cox–Munk; cameras 48×64 px over 12°, "
         "yaw 0, looking upwind (wind direction 0, 15 m mast) or crosswind (wind direction π/2, 20 m mast), pitch −6° "
         "and −16°; flat sea in both renderers. Textured: `rs.render(..., output='brightness_temperature', "
@@ -724,11 +724,16 @@ def main() -> None:
                         help=f"TableSize.{field} of the textured renders ({what}; default: the renderer's)")
     ap.add_argument("--shadowing", choices=("eq5", "correlated"), default="eq5",
                     help="SeaScene(shadowing=) of the textured renders: the paper's Eq. 5 (default) or 'correlated'")
+    ap.add_argument("--seed", type=int, default=None, help="the compared realization's seed (default 11)")
+    ap.add_argument("--time", type=float, default=None, help="its time [s] (default 3)")
     ap.add_argument("--cases", nargs="+", default=None, metavar="DIR:WIND:PITCH",
                     help="only these cases, e.g. upwind:5:-6 crosswind:*:-6 ('*' matches any; default: all)")
     args = ap.parse_args()
     torch.set_num_threads(max(1, args.threads))
-    global TABLE, SHADOWING
+    global TABLE, SHADOWING, SEED, TIME_S
+    SEED = SEED if args.seed is None else args.seed
+    TIME_S = TIME_S if args.time is None else args.time
+    args.seed, args.time = SEED, TIME_S
     SHADOWING = True if args.shadowing == "eq5" else args.shadowing
     hit = {field: getattr(args, flag[2:].replace("-", "_")) for flag, field, _ in HIT_OPTIONS}
     hit = {k: v for k, v in hit.items() if v is not None}
@@ -736,10 +741,15 @@ def main() -> None:
     suffix = "" if args.texture_hit == rs.TableSize().texture_hit else f"_{args.texture_hit}"
     suffix += "".join(f"_{flag[6:]}{v:g}" for flag, field, _ in HIT_OPTIONS if (v := hit.get(field)) is not None)
     suffix += "_correlated" if args.shadowing == "correlated" else ""
+    suffix += f"_seed{SEED}" if (SEED, TIME_S) != (11, 3.0) else ""
     suffix += "_cases" if args.cases else ""
     if args.replot or args.retexture:
         with open(args.replot or args.retexture, "rb") as fh:
             saved = pickle.load(fh)
+        # the saved realization (pickles before --seed: 11 at 3 s)
+        SEED, TIME_S = getattr(saved["args"], "seed", 11), getattr(saved["args"], "time", 3.0)
+        if (SEED, TIME_S) != (11, 3.0) and "_seed" not in suffix:
+            suffix = suffix.removesuffix("_cases") + f"_seed{SEED}" + ("_cases" if args.cases else "")
         if args.cases:
             saved = dict(saved, cases=[c for c in saved["cases"] if selected(c, args.cases)],
                          ens=[e for e in saved["ens"] if selected(e, args.cases)])
@@ -776,7 +786,8 @@ def main() -> None:
                + (f" --texture-hit {args.texture_hit}" if args.texture_hit != rs.TableSize().texture_hit else "")
                + "".join(f" {flag} {v:g}" for flag, field, _ in HIT_OPTIONS if (v := hit.get(field)) is not None)
                + (f" --cases {' '.join(args.cases)}" if args.cases else "")
-               + (" --shadowing correlated" if args.shadowing == "correlated" else ""))
+               + (" --shadowing correlated" if args.shadowing == "correlated" else "")
+               + (f" --seed {SEED} --time {TIME_S:g}" if (SEED, TIME_S) != (11, 3.0) else ""))
 
     combos = [(d, w, p) for d in DIRECTIONS for w in winds for p in PITCHES
               if not args.cases or selected(dict(direction=d, wind=w, pitch=p), args.cases)]
