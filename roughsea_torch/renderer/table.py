@@ -53,7 +53,7 @@ from .plan import RenderPlan
 from .settings import FINE_OVERHANG
 from .sky_terms import day_sky_pixels, sky_per_image, sky_rows, sky_with_day, sun_disk_pixels
 from .spectral import barycentric
-from .texture import warn_scaled
+from .texture import warn_eq7, warn_scaled
 
 __all__ = ["render_table", "node_values", "fine_table", "table_maps", "lookup", "per_pixel_terms"]
 
@@ -114,6 +114,8 @@ def render_table(plan: RenderPlan) -> torch.Tensor:
     parts = map_chunks(chunk_of, chunks, device)
     if plan.textured and plan.texture.scaled:
         warn_scaled()
+    if plan.textured and plan.texture.eq7_vanishing:
+        warn_eq7()
     if parts[0] is None:
         return out
     return parts[0] if len(parts) == 1 else torch.cat(parts)

@@ -35,7 +35,7 @@ from .scene import SceneParameters
 from .sky_terms import sky_per_image
 from .spectral import lobatto_interp
 
-__all__ = ["TextureTable", "sky_of_chunk", "single_quantile", "warn_scaled", "SCALE_WARNING"]
+__all__ = ["TextureTable", "sky_of_chunk", "single_quantile", "warn_scaled", "warn_eq7", "SCALE_WARNING"]
 
 # render() warns when reconcile_scale scales some pixel's resolved slopes by less than this (their
 # variance more than halved): the texture is then markedly weaker than the spectrum alone would give.
@@ -110,6 +110,7 @@ class TextureTable:
         self.hit_visibility = float(table.texture_hit_visibility)
         self.hit_layout = {k: v * self.hit_visibility for k, v in self.hit_steps.items()}
         self.scaled = False  # whether some resolved slopes were scaled down (reconcile_scale)
+        self.eq7_vanishing = False  # whether Eq. 7's projected area vanished at some node (warn_eq7)
 
     def _scale(self, cos_view: torch.Tensor) -> Any:
         """The footprint of the texture's nodes, in whole pixels' along-view footprints: 1, or with the
@@ -210,9 +211,20 @@ class TextureTable:
                                                                           (shifted.var_crosswind, vy[img, 0, 0]),
                                                                           (shifted.cov, cxy[img, 0, 0]))]
         moments += [torch.cat([m, torch.zeros_like(m[:, :1])], 1) for m in (shifted.mean_upwind, shifted.mean_crosswind)]
+        if self.scene.shadowing is False and not self.eq7_vanishing:
+            self._check_eq7(shifted, ph, ct, x)
         if self.cross:  # 2 × nx more columns: the resolved across-view residual as geometry at y = ±√3
             moments = self._cross_columns(moments, cov, phw, var_a, kap, full, ph, x.shape[1])
         return active, idx, ct, ph, moments, x_vis
+
+    def _check_eq7(self, shifted: Any, ph: torch.Tensor, ct: torch.Tensor, x: torch.Tensor) -> None:
+        """Flags the render when, without shadowing (Eq. 7), a node within 3 σ_a of the resolved slope's
+        mean tilts the mean facet away from the sensor (e = cos θ̂ + sin θ̂ m∥ ≤ 0): Eq. 7 then divides by a
+        projected area that vanishes or is negative, and the texture there means nothing (:func:`warn_eq7`)."""
+        m_par = shifted.mean_upwind * torch.cos(ph)[:, None] + shifted.mean_crosswind * torch.sin(ph)[:, None]
+        e = ct[:, None] + torch.sqrt((1.0 - ct * ct).clamp_min(0.0))[:, None] * m_par
+        if bool(((e <= 0) & (x.abs() <= 3.0)).any()):
+            self.eq7_vanishing = True
 
     @staticmethod
     def _cross_columns(moments: list, cov: tuple, phw: torch.Tensor, var_a: torch.Tensor, kap: torch.Tensor,
@@ -570,15 +582,30 @@ def single_quantile(stats: SlopeStatistics) -> SlopeStatistics:
         stats.mean_upwind[..., 0], stats.mean_crosswind[..., 0])
 
 
+def warn_eq7() -> None:
+    """The warning of a textured render without shadowing whose resolved tilts turn the mean facet away
+    (:meth:`TextureTable._check_eq7`), pointing at the user's line (as :func:`warn_scaled`)."""
+    warnings.warn("SeaScene(shadowing=False, seed=...): near grazing the resolved waves tilt some pixels' mean facet "
+                  "away from the sensor, where Eq. 7 divides by a projected area that vanishes or is negative: "
+                  "the texture there is meaningless (radiances far out of range). Use shadowing=True (Eq. 5) or "
+                  "'correlated' for textured seas seen near grazing.", stacklevel=_user_level())
+
+
+def _user_level() -> int:
+    """The stacklevel of the first frame outside this package, kornia and torch, seen from the caller's caller."""
+    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # the package, roughsea_torch/
+    others = tuple(os.path.dirname(os.path.abspath(m.__file__)) for m in (torch, sys.modules.get("kornia")) if m is not None)
+    frame, level = sys._getframe(2), 2
+    while frame is not None and frame.f_code.co_filename.startswith((here, *others)):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
 def warn_scaled() -> None:
     """The warning of :func:`~roughsea_torch.clutter.reconcile_scale`, from the calling thread (the
     chunks run on workers) and pointing at the user's line: the first frame outside this package,
     kornia and torch (an augmentation's own call chain runs through both)."""
-    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # the package, roughsea_torch/
-    others = tuple(os.path.dirname(os.path.abspath(m.__file__)) for m in (torch, sys.modules.get("kornia")) if m is not None)
-    frame, level = sys._getframe(1), 2  # stacklevel 2: the caller of this function
-    while frame is not None and frame.f_code.co_filename.startswith((here, *others)):
-        frame, level = frame.f_back, level + 1
+    level = _user_level()
     # one fixed text, so Python's default filter shows it once per calling line, not once a batch
     warnings.warn("SeaScene(seed=...): where a pixel's footprint resolves more slope variance in the wave spectrum than "
                   "the scene's slope law allows (ECKV against Cox-Munk: light winds, centimetre footprints), the "

@@ -457,3 +457,20 @@ def test_across_quantile_reads_the_residual_of_a_constructed_slope(dtype):
                                d[0].to(dtype), d[1].to(dtype), x.to(dtype))
         tol = 1e-10 if dtype == torch.float64 else 1e-4
         torch.testing.assert_close(got.double(), y, rtol=0, atol=tol)
+
+
+@pytest.mark.parametrize("hit", ["flat", "first"])
+def test_textured_sea_without_shadowing_near_grazing_warns(hit):
+    """Without shadowing (Eq. 7) the facet weight divides by the mean facet's projected area
+    e = cos θ̂ + sin θ̂ m∥, which a resolved tilt turns ≤ 0 near grazing: a textured render 3° down from 15 m
+    then holds radiances of ±8e9 W m⁻² sr⁻¹. The render says so (a UserWarning naming shadowing=False,
+    pointing at the caller's line); 45° down, where every node's e stays > 0, it does not. (Planted: the
+    check skipped, no warning, and the first case fails.)"""
+    kw = dict(wind_speed=10.0, sea_temperature=290.0, seed=3, shadowing=False)
+    steep, grazing = (rs.make_camera(32, 48, hfov_deg=12.0, altitude_m=15.0, pitch_deg=p) for p in (-45.0, -3.0))
+    with pytest.warns(UserWarning, match="shadowing=False") as record:
+        img = rs.render(grazing, rs.SeaScene(**kw), table=rs.TableSize(texture_hit=hit))
+    assert record[0].filename == __file__ and float(img.abs().max()) > 1e3  # the nonsense it warns of
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rs.render(steep, rs.SeaScene(**kw), table=rs.TableSize(texture_hit=hit))
