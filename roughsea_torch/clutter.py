@@ -52,7 +52,7 @@ import torch
 from .slopes import SlopeStatistics
 
 __all__ = ["visible_slope", "unresolved_statistics", "two_scale_statistics", "pixel_resolved_slope", "resolved_quantile",
-           "along_view", "footprint",
+           "along_view", "view_moments", "footprint",
            "reconcile_scale"]
 
 _SQRT_HALF = math.sqrt(0.5)
@@ -174,14 +174,31 @@ def two_scale_statistics(
     return (stats, ap / sig_a[e]) if return_visible else stats
 
 
+def _along(cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], ex: torch.Tensor, ey: torch.Tensor
+           ) -> tuple[torch.Tensor, torch.Tensor]:
+    """(σ_a², c_a⊥): the variance along ê = (ex, ey) of a slope field of covariance ``cov`` = (var_x,
+    var_y, cov_xy), and the covariance of its components along ê and ê⊥ (ê turned +90°)."""
+    cxx, cyy, cxy = cov
+    return (cxx * ex * ex + 2.0 * cxy * ex * ey + cyy * ey * ey,
+            (cyy - cxx) * ex * ey + cxy * (ex * ex - ey * ey))
+
+
+def view_moments(cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], ex: torch.Tensor, ey: torch.Tensor
+                 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """(σ_a², c_a⊥, σ_⊥²): the covariance of a slope field (``cov`` = (var_x, var_y, cov_xy)) in the frame
+    of the unit vector ê = (ex, ey) and ê⊥ (ê turned +90°): the variances along each and their covariance
+    (:func:`along_view`'s κ_r = c_a⊥/σ_a²; the across-view residual's variance is σ_⊥² − c_a⊥²/σ_a²)."""
+    var_a, cov_ap = _along(cov, ex, ey)
+    cxx, cyy, cxy = cov
+    return var_a, cov_ap, cxx * ey * ey - 2.0 * cxy * ex * ey + cyy * ex * ex
+
+
 def along_view(cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], ex: torch.Tensor, ey: torch.Tensor
                ) -> tuple[torch.Tensor, torch.Tensor]:
     """(σ_a², κ_r): the variance of a slope field of covariance ``cov`` = (var_x, var_y, cov_xy)
     along the unit vector ê = (ex, ey), and the regression of its component along ê⊥ (ê turned
     +90°) on that along ê (0 where σ_a² = 0)."""
-    cxx, cyy, cxy = cov
-    var_a = cxx * ex * ex + 2.0 * cxy * ex * ey + cyy * ey * ey
-    cov_ap = (cyy - cxx) * ex * ey + cxy * (ex * ex - ey * ey)
+    var_a, cov_ap = _along(cov, ex, ey)
     ok = var_a > 1e-30
     kappa = torch.where(ok, cov_ap / torch.where(ok, var_a, torch.ones_like(var_a)), torch.zeros_like(var_a))
     return torch.where(ok, var_a, torch.zeros_like(var_a)), kappa

@@ -276,9 +276,10 @@ def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tens
     dtype = x.dtype
     extra = (None,) * (x.ndim - 1)
     a = active_share(wf.wind_speed, wf.inverse_wave_age, decay_s).to(dtype)[(...,) + extra]
-    # the drift in float64 whatever the dtype: it moves the streak field by v t, which at large t (1e5–1e9 s)
-    # is far more than a streak is wide, so a velocity or direction rounded to float32 would draw other streaks
-    vx64, vy64 = foam_drift(wf.wind_speed.double(), wf.wind_direction.double())
+    # the drift in float64 whatever the dtype (the field keeps its wind in float64): it moves the streak field
+    # by v t, which at large t (1e5–1e9 s) is far more than a streak is wide, so a velocity or direction rounded
+    # to float32 would draw other streaks
+    vx64, vy64 = foam_drift(wf.wind_speed, wf.wind_direction)
     vx, vy = (v.to(dtype)[(...,) + extra] for v in (vx64, vy64))
     epochs, weights = deposit_epochs(time_s, decay_s)
 

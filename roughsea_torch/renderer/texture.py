@@ -21,7 +21,7 @@ import torch
 import torch.nn.functional as F
 
 from .._validation import per_batch
-from ..clutter import along_view, footprint, reconcile_scale, resolved_quantile, two_scale_statistics
+from ..clutter import along_view, footprint, reconcile_scale, resolved_quantile, two_scale_statistics, view_moments
 from ..expectation import reflection_terms
 from ..geometry import slant_range
 from ..sky import ConstantSky, TabulatedSky, select_sky
@@ -98,6 +98,8 @@ class TextureTable:
         # the across-view resolved slope as texture too (first hit): two more channels, the quadratic's
         # coefficients in y = c_r/σ_r (TableSize.texture_hit_cross)
         self.cross = self.first_hit and bool(table.texture_hit_cross)
+        # the volume's channels that are radiances (τ applies): Δ, (x' with a sun: not), (g, h across)
+        self.radiance_channels = [True] + ([False] if scene.sun is not None else []) + [True, True] * self.cross
         self.foam_trails = bool(table.foam_trails)
         self.antialias = bool(table.texture_antialias)  # (renderer.antialias; the sweep is not filtered)
         # the sweep (TableSize.texture_hit_*): samples s(θ̂) pixels apart in depression, each filtered at
@@ -212,17 +214,18 @@ class TextureTable:
                                                                           (shifted.cov, cxy[img, 0, 0]))]
         moments += [torch.cat([m, torch.zeros_like(m[:, :1])], 1) for m in (shifted.mean_upwind, shifted.mean_crosswind)]
         if self.scene.shadowing is False and not self.eq7_vanishing:
-            self._check_eq7(shifted, ph, ct, x)
+            self._check_eq7(ct, x_vis * va_.sqrt()[:, None], x)
         if self.cross:  # 2 × nx more columns: the resolved across-view residual as geometry at y = ±√3
             moments = self._cross_columns(moments, cov, phw, var_a, kap, full, ph, x.shape[1])
         return active, idx, ct, ph, moments, x_vis
 
-    def _check_eq7(self, shifted: Any, ph: torch.Tensor, ct: torch.Tensor, x: torch.Tensor) -> None:
+    def _check_eq7(self, ct: torch.Tensor, a_vis: torch.Tensor, x: torch.Tensor) -> None:
         """Flags the render when, without shadowing (Eq. 7), a node within 3 σ_a of the resolved slope's
-        mean tilts the mean facet away from the sensor (e = cos θ̂ + sin θ̂ m∥ ≤ 0): Eq. 7 then divides by a
-        projected area that vanishes or is negative, and the texture there means nothing (:func:`warn_eq7`)."""
-        m_par = shifted.mean_upwind * torch.cos(ph)[:, None] + shifted.mean_crosswind * torch.sin(ph)[:, None]
-        e = ct[:, None] + torch.sqrt((1.0 - ct * ct).clamp_min(0.0))[:, None] * m_par
+        mean tilts the mean facet away from the sensor: its along-view mean slope is a' (``a_vis``, (M, nx);
+        :func:`~roughsea_torch.clutter.unresolved_statistics`), and where e = cos θ̂ + sin θ̂ a' ≤ 0 Eq. 7
+        divides by a projected area that vanishes or is negative, so the texture there means nothing
+        (:func:`warn_eq7`)."""
+        e = ct[:, None] + torch.sqrt((1.0 - ct * ct).clamp_min(0.0))[:, None] * a_vis
         if bool(((e <= 0) & (x.abs() <= 3.0)).any()):
             self.eq7_vanishing = True
 
@@ -233,7 +236,7 @@ class TextureTable:
         κ_r² σ_a², independent of a) taken out of the unresolved covariance and put into the mean at
         c_r = y σ_r, y = −√3, √3 (ê⊥ = ê turned +90°, in the upwind frame (−sin φ̂, cos φ̂)), appended
         to the first nx columns of ``moments`` (var_up, var_cr, cov, mean_up, mean_cr)."""
-        var_p, _ = along_view(cov, -torch.sin(phw)[:, None, :], torch.cos(phw)[:, None, :])
+        var_p = view_moments(cov, torch.cos(phw)[:, None, :], torch.sin(phw)[:, None, :])[2]
         var_r = full((var_p - kap * kap * var_a).clamp_min(0.0))[:, None]  # (M, 1)
         sig_r = var_r.sqrt()
         px, py = -torch.sin(ph)[:, None], torch.cos(ph)[:, None]
@@ -296,14 +299,10 @@ class TextureTable:
             cos_rows = (self.eps[sl][:, None] * torch.sinh(lo[:, None] + span_z[:, None] * (y + 1) / 2)).clamp(0.0, 1.0).to(dtype)
             tau, _ = path_rows(self.scene.path, cos_rows, h[:, None], self.earth_radius_m)
             t_ = tau.to(dtype)[:, None, :, None, None]
-            # τ on the radiance channels: Δ and, with the across-view texture, its two coefficients (the last)
-            if vol.requires_grad or t_.requires_grad:
-                parts = [vol[:, :1] * t_, vol[:, 1:vol.shape[1] - 2 * self.cross]]
-                vol = torch.cat(parts + ([vol[:, -2:] * t_] if self.cross else []), 1)
-            else:  # in place on the einsum's own output
-                vol[:, :1] *= t_
-                if self.cross:
-                    vol[:, -2:] *= t_
+            rad = torch.tensor(self.radiance_channels, device=device)[None, :, None, None, None]
+            t_ = torch.where(rad, t_, torch.ones_like(t_))  # (b, C, ...): τ on the radiance channels, 1 elsewhere
+            # (in place on the einsum's own output where nothing needs its graph)
+            vol = vol * t_ if vol.requires_grad or t_.requires_grad else vol.mul_(t_)
         return vol.flatten(-2)
 
     def pixels(self, sl: slice, vol: torch.Tensor, cos_t: torch.Tensor, zeta: torch.Tensor, o: torch.Tensor,
@@ -550,12 +549,8 @@ def _across_quantile(slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple, d
     dy) the unit horizontal direction towards the sensor) less its regression κ_r a on the along-view
     slope a = x σ_a, over the residual's rms σ_r; clamped to ±3.5 (the quadratic in y is fitted at ±√3); 0
     where σ_r² ≤ 1e-12 σ_a² (nothing resolved across)."""
-    cxx, cyy, cxy = cov
     ex, ey = -dx, -dy
-    exy, exx, eyy = ex * ey, ex * ex, ey * ey
-    var_a = cxx * exx + 2.0 * cxy * exy + cyy * eyy
-    cov_ap = (cyy - cxx) * exy + cxy * (exx - eyy)  # (:func:`~roughsea_torch.clutter.along_view`'s κ_r σ_a²)
-    var_p = cxx * eyy - 2.0 * cxy * exy + cyy * exx
+    var_a, cov_ap, var_p = view_moments(cov, ex, ey)
     ok_a = var_a > 1e-30
     inv_a = torch.where(ok_a, var_a, torch.ones_like(var_a)).reciprocal()
     var_r = var_p - cov_ap * cov_ap * inv_a
