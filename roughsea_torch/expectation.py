@@ -47,7 +47,7 @@ from ._validation import as_tensor, check_finite_range, check_same_device
 from .atmosphere import as_sky
 from .facets import FacetGeometry, denominator, facet_geometry, normal_cdf, normal_pdf, prepare_inputs, visible_ratio
 from .foam import foam_radiance, foam_sky_radiance, with_foam
-from .masking import check_shadowing, masked_denominator, masking_ratio, view_nu
+from .masking import MASKED_OPTIONS, check_shadowing, facet_masking, masked_denominator, view_nu
 from .optics import fresnel_terms, split_refractive_index
 from .quadrature import Quadrature, gauss_nodes
 from .radiometry import LWIR
@@ -105,8 +105,8 @@ def _emissivity_numerator(
         half = 0.5 * (hi - lo)
         x = (0.5 * (hi + lo))[:, None] + half[:, None] * xg  # (m, no)
         W = half[:, None] * wg * normal_pdf(x)
-        if shadowing == "correlated":  # the slope-conditioned masking (roughsea_torch.masking)
-            W = W * masking_ratio(x, view_nu(g)[:, None])
+        if shadowing in MASKED_OPTIONS:  # the slope-conditioned or multi-scale masking (roughsea_torch.masking)
+            W = W * facet_masking(shadowing, x, view_nu(g)[:, None])
         du = g.su[:, None] * x
         u = g.mu[:, None] + du
         t = g.ct[:, None] + g.st[:, None] * u
@@ -147,8 +147,8 @@ def _sky_numerator(
     h = (inv_ct * torch.sin(psi0[:, None] + delta)).clamp_min(0.0)  # half-chord = du/dψ
     x = (u - mu[:, None]) / su[:, None]
     W = wdelta * h * normal_pdf(x) / su[:, None]
-    if shadowing == "correlated":  # the slope-conditioned masking (roughsea_torch.masking)
-        W = W * masking_ratio(x, view_nu(g)[:, None])
+    if shadowing in MASKED_OPTIONS:  # the slope-conditioned or multi-scale masking (roughsea_torch.masking)
+        W = W * facet_masking(shadowing, x, view_nu(g)[:, None])
     t = ct[:, None] + st[:, None] * u
     c = mv[:, None] + g.kappa[:, None] * (u - mu[:, None])
     tau = g.tau[:, None]
@@ -348,9 +348,9 @@ def projected_area(view_zenith: Any, view_azimuth: Any, slopes: SlopeStatistics,
         D [dimensionless]: cos θ̂ Φ(μ) + sin θ̂ σ∥ φ(μ) with μ = cot θ̂/σ∥ (= cos θ̂ (1 + Λ), Smith's
         shadowing function Λ), or cos θ̂ without shadowing (Eq. 7).
     """
-    if check_shadowing(shadowing) == "correlated":
-        raise ValueError("projected_area: shadowing must be True (Eq. 5) or False (Eq. 7); the correlated "
-                         "masking's normalization is not a projected area")
+    if check_shadowing(shadowing) in MASKED_OPTIONS:
+        raise ValueError(f"projected_area: shadowing must be True (Eq. 5) or False (Eq. 7); the {shadowing!r} "
+                         "masking's normalization is not Eq. 5's projected area")
     _, _, vz, va, vx, vy, cxy, mx, my = prepare_inputs(view_zenith, view_azimuth, slopes)
     return denominator(facet_geometry(vz, va, vx, vy, cxy, mx, my), shadowing)
 
@@ -381,7 +381,8 @@ def emissivity(
         shadowing: Eq. 5 (True, default) or Eq. 7 (False; facets turned away then count with
             negative weight and ρ at |cos Ω|, as Eq. 4 is written); or "correlated": Eq. 5 with the
             slope-conditioned masking of :mod:`roughsea_torch.masking` (facets tilted towards the
-            sensor weigh more near grazing).
+            sensor weigh more near grazing); or "multiscale": Eq. 5 with the masking of a sea of many
+            scales (:mod:`roughsea_torch.multiscale_masking`; the mean a ray tracer of the waves gives).
         quadrature: accuracy control; ``Quadrature.default(dtype)`` when None.
 
     Returns:
@@ -413,9 +414,9 @@ def emissivity(
 
 
 def _denominator(g: FacetGeometry, shadowing: bool | str, q: Quadrature) -> torch.Tensor:
-    """D of Eq. 5/7 (closed form), or D_Q of the correlated masking on the emissivity's own nodes."""
-    if shadowing == "correlated":
-        return masked_denominator(g, q.outer, q.width)
+    """D of Eq. 5/7 (closed form), or D_Q of a masked option on the emissivity's own nodes."""
+    if shadowing in MASKED_OPTIONS:
+        return masked_denominator(g, q.outer, q.width, shadowing)
     return denominator(g, shadowing)
 
 
@@ -459,8 +460,10 @@ def apparent_radiance(
         sea_radiance: R_B, blackbody radiance at the sea temperature [W m⁻² sr⁻¹], ≥ 0.
         sky: R_s(θ'): a callable of cos(zenith), a (zenith [rad], radiance) table, a
             :class:`~roughsea_torch.sky.TabulatedSky`, a constant, or a named atmosphere.
-        shadowing: Eq. 5 (True, default), Eq. 7 (False), or "correlated" (Eq. 5 with the
-            slope-conditioned masking of :mod:`roughsea_torch.masking`; the sun's glint keeps Eq. 5).
+        shadowing: Eq. 5 (True, default), Eq. 7 (False), "correlated" (Eq. 5 with the
+            slope-conditioned masking of :mod:`roughsea_torch.masking`) or "multiscale" (Eq. 5 with the
+            masking of a sea of many scales, :mod:`roughsea_torch.multiscale_masking`); the sun's glint
+            keeps Eq. 5 with either.
         quadrature: accuracy control; ``Quadrature.default(dtype)`` when None.
         sun: ``None`` (default: no sun, every result as without it) or a
             :class:`~roughsea_torch.sun.Sun`: its reflection off the waves (the glint,
@@ -494,7 +497,7 @@ def apparent_radiance(
         if not isinstance(sun, Sun):
             raise ValueError(f"sun must be None or a roughsea_torch.Sun; got {type(sun).__name__}")
         out = out + glint_radiance(view_zenith, view_azimuth, slopes, refractive_index, sun, bool(shadowing),
-                                   sun_masking)  # the glint keeps Eq. 5's weight with "correlated" (docs/shadowing.md)
+                                   sun_masking)  # the glint keeps Eq. 5's weight with a masked option (docs/shadowing.md)
     if foam_fraction is not None:
         check_finite_range("foam_fraction", foam_fraction, 0.0, 1.0)
         e_sky = foam_sky_radiance(as_sky(sky), LWIR, refractive_index, dtype=out.dtype, device=out.device)

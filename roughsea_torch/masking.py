@@ -20,8 +20,9 @@ t(s) Q, normalized by D_Q = E[t Q H(t)] (:func:`masked_denominator`); Q ≡ 1 wo
 Outside the table: ν < 0.01 (within ~0.1° of grazing) uses ν = 0.01, ν > 8 (no masking left) uses
 ν = 8, x + ν > 16 uses 16, x + ν < 1e-4 uses 1e-4 (the tangent ray, where t ∝ x + ν ≈ 0). The numpy reference is :mod:`roughsea_torch.reference.masking`.
 
-``shadowing`` everywhere takes True (Eq. 5), False (Eq. 7) or "correlated" (this module):
-:func:`check_shadowing`.
+``shadowing`` everywhere takes True (Eq. 5), False (Eq. 7), "correlated" (this module) or "multiscale"
+(:mod:`roughsea_torch.multiscale_masking`, whose factor :func:`facet_masking` and :func:`masked_denominator`
+apply the same way): :func:`check_shadowing`.
 """
 
 from __future__ import annotations
@@ -35,11 +36,13 @@ import numpy as np
 import torch
 
 from .facets import FacetGeometry, normal_cdf, normal_pdf
+from .multiscale_masking import multiscale_ratio
 
-__all__ = ["SHADOWING_OPTIONS", "check_shadowing", "masking_table", "compute_masking_table", "table_nodes", "masking_ratio",
+__all__ = ["SHADOWING_OPTIONS", "MASKED_OPTIONS", "check_shadowing", "facet_masking", "masking_table", "compute_masking_table", "table_nodes", "masking_ratio",
            "masked_denominator", "TABLE_FILE"]
 
-SHADOWING_OPTIONS = (True, False, "correlated")
+SHADOWING_OPTIONS = (True, False, "correlated", "multiscale")
+MASKED_OPTIONS = ("correlated", "multiscale")  # Eq. 5's weight times a masking factor Q of the facet's slope
 NU_MIN, NU_MAX, W_MAX = 0.01, 8.0, 16.0
 W_MIN = 1e-4  # Q is held below x + ν = W_MIN (the tangent ray; t ∝ x + ν weighs it out)
 _N_NU, _N_P = 97, 121
@@ -48,13 +51,20 @@ _L_TAIL = 5.0
 
 
 def check_shadowing(shadowing: Any) -> Any:
-    """``shadowing`` itself if it is True, False or "correlated", else a ValueError naming it."""
-    if isinstance(shadowing, str) and shadowing == "correlated":
+    """``shadowing`` itself if it is True, False, "correlated" or "multiscale", else a ValueError naming it."""
+    if isinstance(shadowing, str) and shadowing in MASKED_OPTIONS:
         return shadowing
     if isinstance(shadowing, (bool, np.bool_)):
         return bool(shadowing)
-    raise ValueError(f"shadowing must be True (Eq. 5), False (Eq. 7) or 'correlated' (slope-conditioned "
-                     f"masking); got {shadowing!r}")
+    raise ValueError(f"shadowing must be True (Eq. 5), False (Eq. 7), 'correlated' (slope-conditioned masking) or "
+                     f"'multiscale' (multi-scale masking); got {shadowing!r}")
+
+
+def facet_masking(shadowing: str, x: torch.Tensor, nu: torch.Tensor) -> torch.Tensor:
+    """The factor on Eq. 5's facet weight of a masked option (:data:`MASKED_OPTIONS`) at standardized
+    along-view slopes ``x`` and ν (:func:`view_nu`): :func:`masking_ratio` ("correlated") or
+    :func:`~roughsea_torch.multiscale_masking.multiscale_ratio` ("multiscale")."""
+    return multiscale_ratio(x, nu) if shadowing == "multiscale" else masking_ratio(x, nu)
 
 
 def _lambda(nu: torch.Tensor) -> torch.Tensor:
@@ -175,9 +185,11 @@ def view_nu(g: FacetGeometry) -> torch.Tensor:
     return e / a.clamp_min(torch.finfo(a.dtype).tiny)
 
 
-def masked_denominator(g: FacetGeometry, nodes: int, width: float) -> torch.Tensor:
+def masked_denominator(g: FacetGeometry, nodes: int, width: float, shadowing: str = "correlated") -> torch.Tensor:
     """D_Q = ∫ N t Q H(t) ds = ∫_{−ν}^{K} φ(x)(e + a x) Q(x, ν) dx by Gauss–Legendre (``nodes``,
-    window ``width`` = K standard deviations), e = cos θ̂ + sin θ̂ m∥, a = sin θ̂ σ∥."""
+    window ``width`` = K standard deviations), e = cos θ̂ + sin θ̂ m∥, a = sin θ̂ σ∥, Q of ``shadowing``
+    (:func:`facet_masking`; "multiscale": D_Q = e⁺ exactly, here on the numerators' own nodes so that
+    their quadrature errors cancel in the ratio)."""
     a = g.st * g.su
     e = g.ct + g.st * g.mu
     nu = view_nu(g)
@@ -189,4 +201,4 @@ def masked_denominator(g: FacetGeometry, nodes: int, width: float) -> torch.Tens
     half = 0.5 * (K - xs)
     x = (0.5 * (K + xs))[..., None] + half[..., None] * xg
     t = e[..., None] + a[..., None] * x
-    return (half[..., None] * wg * normal_pdf(x) * t * masking_ratio(x, nu[..., None])).sum(-1)
+    return (half[..., None] * wg * normal_pdf(x) * t * facet_masking(shadowing, x, nu[..., None])).sum(-1)

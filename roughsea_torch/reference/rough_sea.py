@@ -107,34 +107,57 @@ def _tilted_flat_facet(th, ph, mean):
     return w, cos_omega, 2.0 * cos_omega * cos_theta - math.cos(th)
 
 
-def correlated_weight(shadowing, th, ph, a, b, r, mean=(0.0, 0.0)):
-    """None, or with shadowing="correlated" the masking factor Q(s_par) of this view and slope law
-    (reference.masking.masking_curve at nu = cot(th) / sigma_par; zero-mean laws only)."""
-    if not (isinstance(shadowing, str) and shadowing == "correlated"):
+def masking_weight(shadowing, th, ph, a, b, r, mean=(0.0, 0.0)):
+    """None (Eq. 5 or 7), or the masking factor Q(s_par) on Eq. 5's facet weight of this view and slope
+    law, a function of the facet's slope along the view s_par = tan(theta) cos(phi - ph):
+
+    - "correlated": reference.masking.masking_curve at nu = cot(th) / sigma_par (zero-mean laws only);
+    - "multiscale": the cascade of Smith's masking over the sea's scales, longest first, in the limit
+      of many scales: the along-view slope summed over the scales is a Brownian motion in the
+      cumulative variance, and a facet is seen when the sum faced the sensor at every stage, i.e.
+      cot(th) + s_par stayed > 0 all along. Weighting each stage by its projected area conditions the
+      motion to stay positive (Doob's h-transform with h = cot(th) + s_par); by the reflection principle
+      its end density is (h(s)/h(mu)) [N(s; mu, Sigma) - N(mirror of s; mu, Sigma)], and the ratio of
+      the mirror's density to the facet's is exp(-2 (cot th + s_par)(cot th + mu_par) / sigma_par^2).
+      So Q = 1 - that where cot th + s_par > 0, else 0. The model takes (cot th + mu_par) / sigma_par no
+      smaller than 1e-6 (its limit at the horizon, continued beyond), and so does this reference.
+    """
+    if not (isinstance(shadowing, str) and shadowing in ("correlated", "multiscale")):
         return None
-    if is_shifted(mean):
-        raise NotImplementedError("shadowing='correlated' in the reference needs slope_mean = (0, 0)")
     c, s = math.cos(ph), math.sin(ph)
     sig = math.sqrt(max(a * a * c * c + 2.0 * r * a * b * c * s + b * b * s * s, 0.0))
     if not sig > 0.0:  # no slope along the view: nothing to condition on, Eq. 5
         return None
-    return masking_curve(math.cos(th) / max(math.sin(th), 1e-300) / sig, sig)
+    cot = math.cos(th) / max(math.sin(th), 1e-300)
+    if shadowing == "multiscale":
+        h0 = max(cot + mean[0] * c + mean[1] * s, 1e-6 * sig)
+
+        def q(s_par):
+            h = cot + s_par
+            if h <= 0.0:
+                return 0.0
+            return -math.expm1(-2.0 * (h - (cot + mean[0] * c + mean[1] * s) + h0) * h0 / (sig * sig))
+
+        return q
+    if is_shifted(mean):
+        raise NotImplementedError("shadowing='correlated' in the reference needs slope_mean = (0, 0)")
+    return masking_curve(cot / sig, sig)
 
 
 def check_shadowing(shadowing):
-    """True, False or "correlated", else ValueError."""
-    if isinstance(shadowing, str) and shadowing == "correlated":
+    """True, False, "correlated" or "multiscale", else ValueError."""
+    if isinstance(shadowing, str) and shadowing in ("correlated", "multiscale"):
         return shadowing
     if isinstance(shadowing, (bool, np.bool_)):
         return bool(shadowing)
-    raise ValueError(f"shadowing must be True, False or 'correlated'; got {shadowing!r}")
+    raise ValueError(f"shadowing must be True, False, 'correlated' or 'multiscale'; got {shadowing!r}")
 
 
 def numerator(kind, th, ph, a, b, r, shadowing, m=None, sea_radiance=None, sky=None,
                epsrel=1e-10, method="phi_outer", mean=(0.0, 0.0), epsabs=0.0):
     """Unnormalized integral of p cos(Omega)/cos(theta) [H] g over theta, phi (one scalar case)."""
     fi = FacetIntegral(th, ph, a, b, r, shadowing, kind, m, sea_radiance, sky, mean,
-                       weight=correlated_weight(shadowing, th, ph, a, b, r, mean))
+                       weight=masking_weight(shadowing, th, ph, a, b, r, mean))
     return fi.integral(epsrel, method, epsabs)
 
 
@@ -194,7 +217,7 @@ def projected_area(view_zenith, view_azimuth, slopes, shadowing=True, *, epsrel=
     With shadowing=False and th = pi/2 exactly the (zero-mean) integral is 0 (cos(pi/2)); it is
     computed with an absolute tolerance of 1e-15 there.
     """
-    if check_shadowing(shadowing) == "correlated":
+    if check_shadowing(shadowing) in ("correlated", "multiscale"):
         raise ValueError("projected_area: shadowing must be True or False")
     shadowing = check_shadowing(shadowing)
     th, ph = check_view(view_zenith, view_azimuth)

@@ -137,9 +137,12 @@ class SeaScene:
             of a shipped LOWTRAN7 atmosphere (``"midlatitude_summer"``, the default).
         refractive_index: sea index n + i k; default: water (Hale & Querry) averaged over the band
             with Planck(T_sea) × response weights (the paper's choice).
-        shadowing: Eq. 5 (True, default), Eq. 7 (False), or "correlated": Eq. 5 with the slope-conditioned
-            masking of :mod:`roughsea_torch.masking` (emission and reflected sky; the sun's glint keeps
-            Eq. 5). Anything else is a ``ValueError``.
+        shadowing: Eq. 5 (True, default), Eq. 7 (False), "correlated": Eq. 5 with the slope-conditioned
+            masking of :mod:`roughsea_torch.masking`, or "multiscale": Eq. 5 with the masking of a sea
+            of many scales (:mod:`roughsea_torch.multiscale_masking`: the short waves on the back of a
+            long one are hidden; near grazing the mean a ray tracer of the waves gives, to 0.05 K),
+            each on emission and reflected sky (the sun's glint keeps Eq. 5). Anything else is a
+            ``ValueError``.
         path: the air between sea and sensor: radiance at the sensor = τ · R_a + L_path per sea pixel,
             from its slant range and the camera's altitude (``roughsea_torch.atmosphere.load_path``;
             a camera outside the tables' 2 m – 5 km is a ``ValueError`` at render time; ranges
