@@ -107,6 +107,7 @@ from kornia.geometry.camera import PinholeCamera
 
 from .atmosphere import load_sky
 from .expectation import apparent_radiance
+from .masking import check_shadowing
 from .optics import band_refractive_index, fresnel_reflectance
 from .quadrature import Quadrature
 from .radiometry import LWIR, band_radiance, brightness_temperature
@@ -321,6 +322,7 @@ def raytraced_image(  # ~100 lines: 22 lines of signature, the docstring, then e
     rays_per_pixel: int = 64,
     k_max: float = 64.0,
     mode: str = "two_scale",
+    shadowing: bool | str = True,
     ray_seed: int = 0,
     tolerance_m: float = 1e-7,
     min_step_m: float = 5e-3,
@@ -351,6 +353,9 @@ def raytraced_image(  # ~100 lines: 22 lines of signature, the docstring, then e
         rays_per_pixel: S ≥ 2 (the sampling variance needs two).
         k_max: largest traced wavenumber [rad m⁻¹]; ``inf`` traces every band.
         mode: ``"two_scale"`` (the reference) or ``"specular"`` (module docstring).
+        shadowing: the model's masking of the bands *not* traced, about the traced slope (and of the
+            rays beyond ``max_range_m``): True (Eq. 5, default), "correlated" or "multiscale" (the
+            masking the traced bands themselves get from the march is explicit whatever this is).
         ray_seed, tolerance_m, min_step_m, max_range_m: as :func:`trace_first_hits`.
         rows_per_chunk: image rows traced at once (memory bound; results do not depend on it);
             default about 2**17 rays per chunk.
@@ -371,6 +376,10 @@ def raytraced_image(  # ~100 lines: 22 lines of signature, the docstring, then e
     """
     S = _check_arguments(cameras, wind_speed, wind_direction, sea_temperature, rays_per_pixel, k_max, mode, ray_seed,
                          tolerance_m, min_step_m, max_range_m)
+    shadowing = check_shadowing(shadowing)
+    if shadowing is False:
+        raise ValueError("shadowing: the untraced bands' masking must be True (Eq. 5), 'correlated' or 'multiscale'; "
+                         "Eq. 7 (False) is not a masking")
     out_dtype, dev = cameras.intrinsics.dtype, cameras.device()
     B = cameras.batch_size
     H, W = int(cameras.height[0].item()), int(cameras.width[0].item())
@@ -417,13 +426,14 @@ def raytraced_image(  # ~100 lines: 22 lines of signature, the docstring, then e
                 u = unres[bidx]
                 stats = SlopeStatistics.from_variances(u[:, 0], u[:, 1], u[:, 2]).shifted(s_up[hit], s_cr[hit])
                 rad[hit] = apparent_radiance(vz[hit], los_az[hit], stats, m.to(torch.complex128), rb, sky_fn,
-                                             quadrature=quad)
+                                             shadowing=shadowing, quadrature=quad)
             else:
                 rad[hit] = _specular(tr["slope_x"][hit], tr["slope_y"][hit], tr, hit, m, rb, sky_fn)
         if bool(sky_r.any()):
             rad[sky_r] = torch.as_tensor(sky_fn(tr["cos_view_zenith"][sky_r].neg()), dtype=dt).to(dev)  # ray's own zenith
         if bool(far.any()):
-            rad[far] = apparent_radiance(vz[far], los_az[far], total, m.to(torch.complex128), rb, sky_fn, quadrature=quad)
+            rad[far] = apparent_radiance(vz[far], los_az[far], total, m.to(torch.complex128), rb, sky_fn,
+                                         shadowing=shadowing, quadrature=quad)
         f_up, f_cr = _rotate_to_wind(tr["flat_slope_x"], tr["flat_slope_y"], wdir[:, None, None, None])
         flat_facing = cz + torch.sin(vz) * (f_up * torch.cos(los_az) + f_cr * torch.sin(los_az))
         horiz = torch.sqrt((1.0 - cz * cz).clamp_min(0.0))
