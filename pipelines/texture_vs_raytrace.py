@@ -31,6 +31,8 @@ Usage:
     python pipelines/texture_vs_raytrace.py --replot results.pkl   # report and figures again, no tracing
     python pipelines/texture_vs_raytrace.py --retexture results.pkl --texture-hit first --hit-across 2 \
         --cases upwind:5:-6 crosswind:*:-6   # the textured side again with other sweep settings, some cases
+    python pipelines/texture_vs_raytrace.py --texture-hit first --shadowing multiscale --ray-shadowing multiscale \
+        --save results_ms.pkl   # a masking option on the textured side, and on the ray tracer's untraced waves
 
 Defaults: 64 rays per pixel for the 12 cases, an ensemble of 16 seeds at 4 rays per pixel, the specular
 check at 64 rays per pixel on the two 10 m/s upwind cases, one torch thread (``--threads``); the report
@@ -83,6 +85,7 @@ def scene(wind: float, direction: float, seed, *, sky="midlatitude_summer", pape
 
 TABLE = rs.TableSize()  # the renderer's settings; --texture-hit chooses where pixels meet the resolved waves
 SHADOWING: bool | str = True  # SeaScene(shadowing=) of the textured renders (--shadowing)
+RAY_SHADOWING: bool | str = True  # the ray tracer's masking of the bands it does not trace (--ray-shadowing)
 
 
 # --hit-* options: the sweep's settings of texture_hit="first" (TableSize fields, hits.sample_step)
@@ -91,6 +94,10 @@ HIT_OPTIONS = (("--hit-step", "texture_hit_step", "largest sample spacing in dep
                ("--hit-across", "texture_hit_across", "spacing across * cos(view zenith) / 2 [px]"),
                ("--hit-tracks", "texture_hit_tracks", "ground tracks per pixel width"),
                ("--hit-visibility", "texture_hit_visibility", "elevation of the visibility at this x the sample footprint"))
+
+
+def _masking_name(option: str) -> str:
+    return {"eq5": "Eq. 5", "correlated": "the correlated masking", "multiscale": "the multi-scale masking"}[option]
 
 
 def selected(case: dict, patterns: list[str]) -> bool:
@@ -242,7 +249,7 @@ def run_case(direction_name: str, wind: float, pitch: float, rays: int, bar) -> 
     t_render = time.perf_counter() - t0
     t0 = time.perf_counter()
     out = rt.raytraced_image(cams, wind, seed=SEED, time_s=TIME_S, wind_direction=direction, sea_temperature=T_SEA,
-                             rays_per_pixel=rays, progress=bar.update)
+                             rays_per_pixel=rays, shadowing=RAY_SHADOWING, progress=bar.update)
     t_ray = time.perf_counter() - t0
     ray = out["brightness_temperature"][0, 0].double().numpy()
     noise = out["brightness_temperature_noise_var"][0, 0].double().numpy()
@@ -285,7 +292,7 @@ def run_ensemble(direction_name: str, wind: float, pitch: float, seeds: list[int
                    scene(wind, direction, None, paper=True))
     tex = render(cams, scene(wind, direction, seeds))
     out = rt.raytraced_image(cams, wind, seed=seeds, time_s=TIME_S, wind_direction=direction, sea_temperature=T_SEA,
-                             rays_per_pixel=rays, progress=lambda k: bar.update(k * n))
+                             rays_per_pixel=rays, shadowing=RAY_SHADOWING, progress=lambda k: bar.update(k * n))
     ray = out["brightness_temperature"].double()
     noise = out["brightness_temperature_noise_var"].double().numpy()
     geo = rs.view_geometry(rs.make_camera(H, W, hfov_deg=HFOV, altitude_m=mast, pitch_deg=pitch), earth_radius_m=INF)
@@ -526,7 +533,8 @@ def report(args, cases, ens, spec, ident, timings, command, date) -> str:
         f"table=rs.TableSize(texture_hit={hit!r}{sweep}))` ({'the flat-sea point' if hit == 'flat' else 'the sweep along ground tracks'}). "
         f"Ray-traced: `roughsea_torch.raytrace.raytraced_image`, {args.rays} rays per pixel through i.i.d. points of "
         "the pixel, first hits on the field's bands with k ≤ 64 rad/m (Lipschitz march, bisection to 1e-7 m), the "
-        "remaining slope covariance (Cox–Munk minus the traced bands') averaged by the model about the traced slope.",
+        "remaining slope covariance (Cox–Munk minus the traced bands') averaged by the model about the traced slope"
+        f" ({_masking_name(getattr(args, 'ray_shadowing', 'eq5'))} for those untraced waves).",
         "",
         "σ: standard deviation of the clutter about the row mean, averaged over the bin's 8 rows; the ray tracer's "
         "with its sampling variance removed (the noise column is the rms Monte Carlo error of one of its pixels). "
@@ -722,25 +730,31 @@ def main() -> None:
     for flag, field, what in HIT_OPTIONS:
         ap.add_argument(flag, type=float, default=None,
                         help=f"TableSize.{field} of the textured renders ({what}; default: the renderer's)")
-    ap.add_argument("--shadowing", choices=("eq5", "correlated"), default="eq5",
-                    help="SeaScene(shadowing=) of the textured renders: the paper's Eq. 5 (default) or 'correlated'")
+    ap.add_argument("--shadowing", choices=("eq5", "correlated", "multiscale"), default="eq5",
+                    help="SeaScene(shadowing=) of the textured renders: the paper's Eq. 5 (default), 'correlated' or "
+                         "'multiscale'")
+    ap.add_argument("--ray-shadowing", choices=("eq5", "correlated", "multiscale"), default="eq5",
+                    help="the ray tracer's masking of the bands it does not trace (k > 64 rad/m): Eq. 5 (default) or "
+                         "an option; new traces only (--retexture and --replot keep the saved one)")
     ap.add_argument("--seed", type=int, default=None, help="the compared realization's seed (default 11)")
     ap.add_argument("--time", type=float, default=None, help="its time [s] (default 3)")
     ap.add_argument("--cases", nargs="+", default=None, metavar="DIR:WIND:PITCH",
                     help="only these cases, e.g. upwind:5:-6 crosswind:*:-6 ('*' matches any; default: all)")
     args = ap.parse_args()
     torch.set_num_threads(max(1, args.threads))
-    global TABLE, SHADOWING, SEED, TIME_S
+    global TABLE, SHADOWING, RAY_SHADOWING, SEED, TIME_S
     SEED = SEED if args.seed is None else args.seed
     TIME_S = TIME_S if args.time is None else args.time
     args.seed, args.time = SEED, TIME_S
     SHADOWING = True if args.shadowing == "eq5" else args.shadowing
+    RAY_SHADOWING = True if args.ray_shadowing == "eq5" else args.ray_shadowing
     hit = {field: getattr(args, flag[2:].replace("-", "_")) for flag, field, _ in HIT_OPTIONS}
     hit = {k: v for k, v in hit.items() if v is not None}
     TABLE = rs.TableSize(texture_hit=args.texture_hit, **hit)
     suffix = "" if args.texture_hit == rs.TableSize().texture_hit else f"_{args.texture_hit}"
     suffix += "".join(f"_{flag[6:]}{v:g}" for flag, field, _ in HIT_OPTIONS if (v := hit.get(field)) is not None)
-    suffix += "_correlated" if args.shadowing == "correlated" else ""
+    suffix += f"_{args.shadowing}" if args.shadowing != "eq5" else ""
+    suffix += f"_ray{args.ray_shadowing}" if args.ray_shadowing != "eq5" and not (args.replot or args.retexture) else ""
     suffix += f"_seed{SEED}" if (SEED, TIME_S) != (11, 3.0) else ""
     suffix += "_cases" if args.cases else ""
     if args.replot or args.retexture:
@@ -760,7 +774,11 @@ def main() -> None:
         command = saved["command"] + (f" --texture-hit {args.texture_hit}" if args.texture_hit != "flat" else "")
         command += "".join(f" {flag} {v:g}" for flag, field, _ in HIT_OPTIONS if (v := hit.get(field)) is not None)
         command += f" --cases {' '.join(args.cases)}" if args.cases else ""
-        command += " --shadowing correlated" if args.shadowing == "correlated" else ""
+        command += f" --shadowing {args.shadowing}" if args.shadowing != "eq5" else ""
+        ray_sh = getattr(saved["args"], "ray_shadowing", "eq5")  # the saved trace's
+        args.ray_shadowing = ray_sh
+        if ray_sh != "eq5" and f"_ray{ray_sh}" not in suffix:
+            suffix = suffix.removesuffix("_cases") + f"_ray{ray_sh}" + ("_cases" if args.cases else "")
         if args.retexture:
             command += f"  (textured side again: --retexture, {dt.date.today().isoformat()})"
         saved["args"].texture_hit = args.texture_hit
@@ -786,7 +804,8 @@ def main() -> None:
                + (f" --texture-hit {args.texture_hit}" if args.texture_hit != rs.TableSize().texture_hit else "")
                + "".join(f" {flag} {v:g}" for flag, field, _ in HIT_OPTIONS if (v := hit.get(field)) is not None)
                + (f" --cases {' '.join(args.cases)}" if args.cases else "")
-               + (" --shadowing correlated" if args.shadowing == "correlated" else "")
+               + (f" --shadowing {args.shadowing}" if args.shadowing != "eq5" else "")
+               + (f" --ray-shadowing {args.ray_shadowing}" if args.ray_shadowing != "eq5" else "")
                + (f" --seed {SEED} --time {TIME_S:g}" if (SEED, TIME_S) != (11, 3.0) else ""))
 
     combos = [(d, w, p) for d in DIRECTIONS for w in winds for p in PITCHES

@@ -93,7 +93,8 @@ class TableSize:
             along the view: near grazing the waves down to ``across`` times the pixel's width across
             the view; :func:`~roughsea_torch.renderer.hits.sample_step`), and its ground tracks per
             pixel width. Defaults 1/4, 1/64, 0.7, 1: against a ray trace of the same waves at 80–88.5°
-            they bring σ within 0.85–1.2 in 25 of 29 bins (28 with ``SeaScene(shadowing="correlated")``)
+            they bring σ within 0.85–1.2 in 25 of 29 bins (28 with ``SeaScene(shadowing="correlated")``, 27
+            with "multiscale")
             where 1/32 and 1 gave 23 (24), at 1.3–1.8× the time (``docs/texture.md`` §11).
         texture_hit_visibility: in (0, 1]: the factor on the sweep's sample footprint F_s of the
             elevation its running horizon (the visibility) is taken on; its spacings (step, min_step,
