@@ -173,6 +173,10 @@ def reading(results: dict, stages: dict, baseline: bool) -> list[str]:
                    f"for the whole default render; the wave-field reads are {100 * reads / total:.0f} % of it, the foam "
                    f"at the samples {100 * st.t['foam at the samples'] / total:.0f} % (its streak noise "
                    f"{100 * st.t[Stages.NESTED] / total:.0f} %).")
+    two = [results[(2, size, "15 m, −6°")]["first-hit"] / results[(1, size, "15 m, −6°")]["first-hit"] for size in SIZES]
+    out.append(f"- Two threads against one, first hit at 15 m, −6°: {two[0]:.2f}× (512×640) and {two[1]:.2f}× (256×320) the "
+               "time. A render of one image runs on one intra-op thread (`_parallel.one_thread`, called by `render`), "
+               "so torch's own parallel loops (e.g. `grid_sample`'s over the batch) do not serve it.")
     out += ["- The cost is the number of samples: the elevation at every one of them (the running horizon needs it) "
             "and the slopes, crest variable, texture and foam at the visible ones within the track's windows. The "
             "coarser sweeps above trade samples for accuracy against the ray tracer (docs/texture.md, the sweep).", ""]

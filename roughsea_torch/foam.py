@@ -131,6 +131,7 @@ __all__ = [
     "CREST_FOAM_FLOOR",
     "crest_foam_fraction",
     "crest_fraction_from_variances",
+    "vanishing_crest",
 ]
 
 MONAHAN_COEFFICIENT = 3.84e-6  # Monahan & O'Muircheartaigh 1980, W = a U10^b (fraction, U10 in m/s)
@@ -580,3 +581,25 @@ def crest_fraction_from_variances(x: torch.Tensor, v_r: torch.Tensor, v_t: torch
     f = torch.where(known, f, w)
     return torch.where(inner, f, torch.ones_like(f))
 
+
+
+# erfc(a) and its derivative −(2/√π) e^(−a²) are exactly 0 in float32 from a ≈ 10.2 and in float64 from
+# a ≈ 27.3 (underflow); with a margin (which also covers the rounding of the arguments, relative 1e-7 or less)
+_ERFC_ZERO = {torch.float32: 11.0, torch.float64: 28.0}
+
+
+def vanishing_crest(v_r: torch.Tensor, v_t: torch.Tensor, w: torch.Tensor, dtype: torch.dtype,
+                    floor: float = CREST_FOAM_FLOOR) -> torch.Tensor:
+    """x₀ (float64, the broadcast shape): :func:`crest_fraction_from_variances` (x, ``v_r``, ``v_t``,
+    ``w``) computed in ``dtype`` is exactly 0, and so are its derivatives, for every crest x ≤ x₀; +inf
+    where it does not depend on x (W ≥ 1: 1; no crest variance: W); −inf for a dtype other than float32
+    and float64. f = Φ(z) = erfc(−z/√2)/2, z = (x − c)/σ_u, underflows to 0 with its derivative from
+    −z/√2 ≥ a (a = 11 in float32, 28 in float64: erfc is 0 from 10.2 and 27.3), i.e. for
+    x ≤ c − √2 a σ_u. (A caller may then skip what only moves x below x₀.)"""
+    a = _ERFC_ZERO.get(dtype)
+    v_r, v_t, w = (t.detach().double() for t in (v_r, v_t, w))
+    v_u = torch.clamp(v_t - v_r, min=0.0) + (floor * floor) * v_t
+    q = -torch.special.ndtri(torch.clamp(w, min=_W_MIN, max=1.0))  # (W ≥ 1: +inf below)
+    x0 = q * torch.sqrt(v_r + v_u) - (math.sqrt(2.0) * (a or 0.0)) * torch.sqrt(v_u)
+    x0 = torch.where((v_u > 0) & (w < 1.0), x0, torch.full_like(x0, math.inf))
+    return x0 if a is not None else torch.full_like(x0, -math.inf)

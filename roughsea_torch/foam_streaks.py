@@ -30,7 +30,8 @@ import torch
 
 from .counter_hash import bits_uniform, splitmix64
 
-__all__ = ["STREAK_LENGTH_M", "STREAK_ANISOTROPY", "streak_lengths", "streak_noise", "resolved_amplitude", "resolved_share"]
+__all__ = ["STREAK_LENGTH_M", "STREAK_ANISOTROPY", "streak_lengths", "streak_noise", "cell_bound", "resolved_amplitude",
+           "resolved_share"]
 
 STREAK_LENGTH_M = 2.0  # [m] ℓ_along, the lattice cell along the wind
 STREAK_ANISOTROPY = 5.0  # ℓ_along / ℓ_across from 20 m/s (Beaufort 8–9: dense streaks)
@@ -70,7 +71,8 @@ def _node_normal(base: torch.Tensor, i: torch.Tensor, j: torch.Tensor) -> torch.
 
 
 def streak_noise(x: torch.Tensor, y: torch.Tensor, seeds: Sequence[int], cos_wind: torch.Tensor, sin_wind: torch.Tensor,
-                 length_along: torch.Tensor, length_across: torch.Tensor, where: torch.Tensor | None = None) -> torch.Tensor:
+                 length_along: torch.Tensor, length_across: torch.Tensor, where: torch.Tensor | None = None,
+                 below: torch.Tensor | None = None) -> torch.Tensor:
     """ν at world points (x, y) [m] (B, ...) of B images (module docstring).
 
     Args:
@@ -79,48 +81,100 @@ def streak_noise(x: torch.Tensor, y: torch.Tensor, seeds: Sequence[int], cos_win
         length_along, length_across: (B,) the lattice cell [m] > 0.
         where: bool, x's shape, or None: ν only there, 0 elsewhere (the far field, where a footprint
             averages ν away, costs nothing).
+        below: float64, x's shape, or None: where ν is certainly at most ``below`` (its cell's bound
+            :func:`cell_bound` is), ν is not computed and 0 is returned (for a caller to whom any
+            ν ≤ ``below`` gives the same result, e.g. a foam cover that is exactly 0 there); elsewhere
+            ν itself. A bound needs the lattice table (points whose cells fill their box); without it
+            ν is computed everywhere.
 
     Returns:
         ν (B, ...), exactly N(0, 1) at every point for a random seed; continuous; differentiable in
-        x, y, the direction and the lengths (not in the node values).
+        x, y, the direction and the lengths (not in the node values). The same values bit for bit
+        whatever ``where``, ``below`` or the number of points (the arithmetic is per point).
     """
     base = splitmix64(torch.tensor([int(sd) for sd in seeds], dtype=torch.int64, device=x.device) * 0x5DEECE66D + 17)
-    # image by image: the transcendental functions' vectorized and scalar paths round differently, and
-    # image i of a batch must be bitwise the image rendered alone (its elements in the same places)
+    # image by image (image i of a batch is then bitwise the image rendered alone), and within an image block
+    # by block of _BLOCK points, so that the per-point temporaries stay in cache
     out = []
     for i in range(x.shape[0]):
         xd, yd = x[i].to(torch.float64), y[i].to(torch.float64)
+        lim = None if below is None else below[i].to(torch.float64)
         if where is not None:
             xd, yd = xd[where[i]], yd[where[i]]
-        c, s, la, lc = (t[i].to(torch.float64) for t in (cos_wind, sin_wind, length_along, length_across))
-        u = (xd * c + yd * s) / la
-        v = (yd * c - xd * s) / lc
-        iu, iv = torch.floor(u.detach()), torch.floor(v.detach())
-        fu, fv = u - iu, v - iv
-        wu = (torch.cos(0.5 * math.pi * fu), torch.sin(0.5 * math.pi * fu))
-        wv = (torch.cos(0.5 * math.pi * fv), torch.sin(0.5 * math.pi * fv))
-        i0, j0 = iu.to(torch.int64), iv.to(torch.int64)
-        nu = sum(wu[p] * wv[q] * z for (p, q), z in zip(_CORNERS, _corner_normals(base[i], i0, j0))).to(x.dtype)
+            lim = None if lim is None else lim[where[i]]
+        shape = xd.shape
+        xd, yd = xd.reshape(-1), yd.reshape(-1)
+        lim = None if lim is None else lim.reshape(-1)
+        frame = tuple(t[i].to(torch.float64) for t in (cos_wind, sin_wind, length_along, length_across))
+        parts = [_block_noise(base[i], xd[a:a + _BLOCK], yd[a:a + _BLOCK], frame,
+                              None if lim is None else lim[a:a + _BLOCK]) for a in range(0, xd.shape[0], _BLOCK)]
+        nu = (torch.cat(parts) if parts else xd).reshape(shape).to(x.dtype)
         out.append(nu if where is None else torch.zeros_like(x[i]).index_put((where[i],), nu))
     return torch.stack(out)
 
 
+_BLOCK = 1 << 15  # points per block of streak_noise's per-point work
 _CORNERS = ((0, 0), (0, 1), (1, 0), (1, 1))
 
 
-def _corner_normals(base: torch.Tensor, i0: torch.Tensor, j0: torch.Tensor) -> list[torch.Tensor]:
-    """z at the four corners (i0 + p, j0 + q) of each point's cell, in :data:`_CORNERS` order. Where the
-    points' cells fill their bounding box densely (at most 4 nodes per point), the box's nodes are hashed
-    once and looked up: one hash and one Φ⁻¹ per node instead of four per point, the same values bit for
-    bit; otherwise (points scattered over a large box) each corner is hashed per point."""
+def _block_noise(base: torch.Tensor, xd: torch.Tensor, yd: torch.Tensor, frame: tuple,
+                 lim: torch.Tensor | None) -> torch.Tensor:
+    """ν (float64) at the points (xd, yd) (P,) of one image, ``frame`` = (cos, sin, ℓ_along, ℓ_across)
+    of the wind; 0 where :func:`cell_bound` ≤ ``lim`` (P,) (not computed), with ``lim`` not None."""
+    c, s, la, lc = frame
+    u = (xd * c + yd * s) / la
+    v = (yd * c - xd * s) / lc
+    iu, iv = torch.floor(u.detach()), torch.floor(v.detach())
+    fu, fv = u - iu, v - iv
+    i0, j0 = iu.to(torch.int64), iv.to(torch.int64)
+    lattice = _node_table(base, i0, j0)
+    sel = None
+    if lattice is not None and lim is not None:
+        table, idx, nj = lattice
+        sel = _flat_true(cell_bound(table).index_select(0, idx) > lim)
+        fu, fv, idx = fu.index_select(0, sel), fv.index_select(0, sel), idx.index_select(0, sel)
+        lattice = table, idx, nj
+    wu = (torch.cos(0.5 * math.pi * fu), torch.sin(0.5 * math.pi * fu))
+    wv = (torch.cos(0.5 * math.pi * fv), torch.sin(0.5 * math.pi * fv))
+    if lattice is None:  # points scattered over a large box: each corner hashed per point
+        corners = [_node_normal(base, i0 + p, j0 + q) for p, q in _CORNERS]
+    else:
+        table, idx, nj = lattice
+        corners = [table.view(-1).index_select(0, idx + (p * nj + q)) for p, q in _CORNERS]
+    nu = sum(wu[p] * wv[q] * z for (p, q), z in zip(_CORNERS, corners))
+    return nu if sel is None else xd.new_zeros(xd.shape).index_put((sel,), nu)
+
+
+def _node_table(base: torch.Tensor, i0: torch.Tensor, j0: torch.Tensor) -> tuple | None:
+    """(z over the box of nodes that the cells (i0, j0) (P,) touch, (ni, nj); each point's cell as a flat
+    index into it; nj), or None where the cells do not fill their box densely (more than 4 nodes per
+    point) or there are no points. One hash and one Φ⁻¹ per node instead of four per point, the same
+    values bit for bit."""
     if i0.numel() == 0:
-        return [_node_normal(base, i0, j0)] * 4
+        return None
     ia, ja = int(i0.min()), int(j0.min())
     ni, nj = int(i0.max()) - ia + 2, int(j0.max()) - ja + 2
     if ni * nj > 4 * i0.numel():
-        return [_node_normal(base, i0 + p, j0 + q) for p, q in _CORNERS]
+        return None
     gi = torch.arange(ia, ia + ni, dtype=torch.int64, device=i0.device)[:, None]
     gj = torch.arange(ja, ja + nj, dtype=torch.int64, device=i0.device)[None, :]
-    table = _node_normal(base, gi, gj).reshape(-1)
-    idx = (i0 - ia) * nj + (j0 - ja)
-    return [table.index_select(0, (idx + (p * nj + q)).reshape(-1)).reshape(idx.shape) for p, q in _CORNERS]
+    return _node_normal(base, gi, gj), (i0 - ia) * nj + (j0 - ja), nj
+
+
+def cell_bound(table: torch.Tensor) -> torch.Tensor:
+    """An upper bound of ν over each cell of a node table z (ni, nj), flat (ni nj,) indexed by the cell's
+    lower corner (the last row and column, no cell's, +inf): (1 + 1e-9) ‖z⁺‖₂ + 1e-12 over the cell's
+    four corners. ν = Σ w_p z_p with weights w_p ≥ 0 whose squares sum to 1, so ν ≤ Σ w_p z_p⁺ ≤ ‖z⁺‖₂
+    (Cauchy–Schwarz); the factor and the term cover the rounding of the weights and of the sum (a few
+    1e-16 of Σ |w_p z_p| ≤ ‖z‖₂, and |z| < 8.3 for a 52-bit uniform)."""
+    zp = table.clamp_min(0.0)
+    zp = zp * zp
+    ss = ((zp[:-1, :-1] + zp[:-1, 1:]) + zp[1:, :-1]) + zp[1:, 1:]
+    out = torch.full_like(table, math.inf)
+    out[:-1, :-1] = torch.sqrt(ss) * (1.0 + 1e-9) + 1e-12
+    return out.view(-1)
+
+
+def _flat_true(mask: torch.Tensor) -> torch.Tensor:
+    """The flat indices (int64, 1-D) where the 1-D bool ``mask`` is True."""
+    return torch.nonzero(mask).view(-1)

@@ -103,7 +103,7 @@ from typing import Any
 import torch
 
 from ._validation import check_finite_range
-from .foam import crest_fraction_from_variances, foam_radiance
+from .foam import crest_fraction_from_variances, foam_radiance, vanishing_crest
 from .foam_streaks import resolved_amplitude, streak_lengths, streak_noise
 from .radiometry import band_radiance, brightness_temperature
 from .spectrum import GRAVITY
@@ -271,7 +271,8 @@ def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tens
 
     Returns:
         (f_active, f_residual), x's shape, each in [0, 1], f_active + f_residual in [0, 1], with
-        E[f_active + f_residual] = W.
+        E[f_active + f_residual] = W. Without trails the points are taken block by block and the streak
+        field is read only where it can change the cover (:func:`_cover_now`); the values are the same.
     """
     dtype = x.dtype
     extra = (None,) * (x.ndim - 1)
@@ -287,24 +288,31 @@ def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tens
     # footprint keeps the share r; the variances given to the threshold are the sum's, so E[B] = W stays exact
     v_norm = torch.sqrt(vx64 * vx64 + vy64 * vy64).clamp_min(1e-30)
     along, across = streak_lengths(wf.wind_speed)
-    t_now = time_s.double()[(...,) + extra]  # the drifting frame in float64 (times and positions may be large)
     root_r = resolved_amplitude(footprint, across.to(dtype)[(...,) + extra])  # √r, r the share the footprint keeps
     keep = None if footprint is None else (root_r.detach() > 0).expand(x.shape)
-    nu = streak_noise(x.double() - vx64[(...,) + extra] * t_now, y.double() - vy64[(...,) + extra] * t_now, wf.seeds,
-                      vx64 / v_norm, vy64 / v_norm, along, across, where=keep).to(dtype)
     s2 = STREAK_VARIANCE_SHARE * total_variance
-    lift = root_r * torch.sqrt(s2.clamp_min(1e-30)) * nu
+    per_nu = root_r * torch.sqrt(s2.clamp_min(1e-30))  # the lift per unit ν
     r = root_r * root_r
     v_res, v_tot = resolved_variance + r * s2, total_variance + s2
+    t = ((whitecap_fraction - TRAILS_FROM) / (TRAILS_FULL - TRAILS_FROM)).clamp(0.0, 1.0)
+    share = t * t * (3.0 - 2.0 * t)  # of the trails in the residual (TRAILS_FROM, TRAILS_FULL above)
+
+    def noise(xs: torch.Tensor, ys: torch.Tensor, where: Any, below: Any) -> torch.Tensor:
+        ex = (...,) + (None,) * (xs.ndim - 1)  # ν at points (B, ...) in the drifting frame, in float64 (times
+        # and positions may be large)
+        tn = time_s.double()[ex]
+        return streak_noise(xs.double() - vx64[ex] * tn, ys.double() - vy64[ex] * tn, wf.seeds, vx64 / v_norm,
+                            vy64 / v_norm, along, across, where=where, below=below).to(dtype)
+
+    if not trails or not bool((share > 0).any()):  # no trails drawn: the residual is the breaking now
+        now = _cover_now(noise, x, y, crest_now, keep, per_nu, v_res, v_tot, whitecap_fraction)
+        return a * now, (1.0 - a) * now
+    lift = per_nu * noise(x, y, keep, None)
 
     def indicator(crest: torch.Tensor) -> torch.Tensor:
         return crest_fraction_from_variances(crest + lift, v_res, v_tot, whitecap_fraction)
 
     now = indicator(crest_now)
-    t = ((whitecap_fraction - TRAILS_FROM) / (TRAILS_FULL - TRAILS_FROM)).clamp(0.0, 1.0)
-    share = t * t * (3.0 - 2.0 * t)  # of the trails in the residual (TRAILS_FROM, TRAILS_FULL above)
-    if not trails or not bool((share > 0).any()):  # no trails drawn: the residual is the breaking now
-        return a * now, (1.0 - a) * now
     residual = torch.zeros_like(crest_now)
     for j in range(epochs.shape[1]):
         age = (time_s - epochs[:, j]).to(dtype)[(...,) + extra]
@@ -312,3 +320,37 @@ def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tens
                                   slopes=False)
         residual = residual + weights[:, j].to(dtype)[(...,) + extra] * indicator(smp["crest"])
     return a * now, (1.0 - a) * torch.lerp(now, residual, share)
+
+
+_COVER_BLOCK = 2**15  # point-evaluations per block of _cover_now (its temporaries stay in cache)
+
+
+def _cover_now(noise: Any, x: torch.Tensor, y: torch.Tensor, crest: torch.Tensor, keep: torch.Tensor | None,
+               per_nu: Any, v_res: torch.Tensor, v_tot: torch.Tensor, w: torch.Tensor) -> torch.Tensor:
+    """The indicator B = Φ of X + s ν at t (:func:`whitecap_cover` without trails), x's shape, block by block
+    of points (each point's arithmetic as on the whole array, so the same values bit for bit). ν is read
+    (``noise``(x, y, where, below), :func:`~roughsea_torch.foam_streaks.streak_noise` in the drifting frame)
+    only where it can lift the cover off exactly 0: the cover and its derivatives are exactly 0 for
+    X + s ν ≤ x₀ (:func:`~roughsea_torch.foam.vanishing_crest`), so where ν ≤ (x₀ − X)/s is certain (its
+    lattice cell's bound) 0 gives the same cover; near grazing that is most points."""
+    shape, b = x.shape, x.shape[0]
+
+    def flat(t: Any) -> Any:  # (B or 1, P), or (B or 1, 1) for a value per image (broadcast, not copied)
+        if not isinstance(t, torch.Tensor) or t.ndim == 0:
+            return t
+        if t.ndim == len(shape) and all(d == 1 for d in t.shape[1:]):
+            return t.reshape(t.shape[0], 1)
+        return t.expand(shape).reshape(b, -1)
+
+    xs, ys, cs, ks, ps, vr, vt, ws = (flat(t) for t in (x, y, crest, keep, per_nu, v_res, v_tot, w))
+    npts = xs.shape[1]
+    step = max(1024, _COVER_BLOCK // max(b, 1))
+    out = []
+    for a in range(0, npts, step):
+        xb, yb, cb, kb, pb, vrb, vtb, wb = (t[:, a:a + step] if isinstance(t, torch.Tensor) and t.ndim == 2
+                                            and t.shape[1] > 1 else t for t in (xs, ys, cs, ks, ps, vr, vt, ws))
+        x0 = vanishing_crest(vrb, vtb, wb, x.dtype)
+        below = ((x0 - cb.detach().double()) / torch.as_tensor(pb).detach().double()).expand(xb.shape)
+        lift = pb * noise(xb, yb, kb, below)
+        out.append(crest_fraction_from_variances(cb + lift, vrb, vtb, wb))
+    return (torch.cat(out, 1) if out else x.new_zeros(b, 0)).reshape(shape)

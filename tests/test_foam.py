@@ -539,3 +539,29 @@ def test_whitecap_patches_are_ellipses_across_the_wind():
     assert len(ratios) >= 30, len(ratios)
     assert 0.35 < float(np.mean(ratios)) < 0.48, np.mean(ratios)
     assert np.mean(across) > 0.7, np.mean(across)
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+def test_vanishing_crest_is_where_the_cover_underflows_to_exactly_zero(dtype):
+    """foam.vanishing_crest x₀: Φ((x − c)/σ_u) = erfc(−z/√2)/2 and its derivative are exactly 0 for
+    x ≤ x₀ (erfc underflows from 10.2 in float32, 27.3 in float64; x₀ puts the argument at 11 and 28),
+    over W from 1e-6 to 0.2, resolved variances from 0 to σ_X², points from a near footprint to the far
+    field; and x₀ is not loose: 2 σ_u above it the cover is no longer 0.
+    W = 1 and a field without crest variance (the cover W, whatever x) give +inf. Fails with the
+    argument's bound at 9.5 (float32) or 26 (float64) instead (planted: nonzero covers at x₀)."""
+    w = torch.tensor([1e-6, 1e-3, 0.01, 0.2], dtype=dtype)[:, None]
+    v_t = torch.tensor(0.7, dtype=dtype)
+    v_r = torch.linspace(0.0, 0.7, 9, dtype=dtype)[None, :]
+    x0 = foam.vanishing_crest(v_r, v_t, w, dtype)
+    assert x0.dtype == torch.float64 and x0.shape == (4, 9) and bool(torch.isfinite(x0).all())
+    for shift in (0.0, -1e-3, -0.5, -5.0):
+        x = (x0 + shift).to(dtype).requires_grad_(True)
+        f = foam.crest_fraction_from_variances(x, v_r, v_t, w)
+        (g,) = torch.autograd.grad(f.sum(), [x])
+        assert bool((f == 0).all()) and bool((g == 0).all())
+    sigma_u = torch.sqrt((v_t - v_r).clamp_min(0) + foam.CREST_FOAM_FLOOR ** 2 * v_t).double()
+    above = (x0 + 2.0 * sigma_u).to(dtype)
+    assert bool((foam.crest_fraction_from_variances(above, v_r, v_t, w) > 0).all())
+    ends = foam.vanishing_crest(torch.tensor([0.2, 0.0], dtype=dtype), torch.tensor([0.7, 0.0], dtype=dtype),
+                                torch.tensor([1.0, 0.01], dtype=dtype), dtype)
+    assert bool(torch.isposinf(ends).all())

@@ -257,3 +257,60 @@ def test_cover_of_a_seed_is_the_same_in_float32_at_large_times(trails):
         f64 = cover(D, t)
         assert 0.05 < float(f64.mean()) < 0.2  # foam at these points: the check below is not on zeros
         assert float((cover(torch.float32, t) - f64).abs().max()) < 1e-3, t
+
+
+def _full_noise(monkeypatch):
+    """whitecaps' streak field read everywhere (its ``below`` dropped): the cover without the skip."""
+    import roughsea_torch.whitecaps as wc
+    read = wc.streak_noise
+    monkeypatch.setattr(wc, "streak_noise", lambda *a, below=None, **k: read(*a, **k))
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+def test_cover_without_trails_is_unchanged_by_skipping_the_streaks(dtype, monkeypatch):
+    """Without trails whitecap_cover reads ν only where it can lift the cover off exactly 0
+    (foam.vanishing_crest); the covers are bitwise those with ν read at every point, on 40 000 points at
+    5–20 cm footprints (10 m/s, 2 images), where the skip leaves out many points (63 % in float32, 19 %
+    in float64); and they do not depend on the block size (2¹⁵ point-evaluations; 1024 here). Fails
+    with the skip's bound on erfc's argument at 8 instead of 11 (float32) or 25 instead of 28 (float64)
+    (planted: covers that should be nonzero are 0)."""
+    import roughsea_torch.foam_streaks as fs
+    import roughsea_torch.whitecaps as wc
+    wf = WaveField(wind_speed=torch.full((2,), 10.0, dtype=D), seed=[3, 4], dtype=dtype)
+    g = torch.Generator().manual_seed(2)
+    x = (torch.rand(2, 20000, generator=g, dtype=D) * 300).to(dtype)
+    y = (torch.rand(2, 20000, generator=g, dtype=D) * 300).to(dtype)
+    fp = (0.05 + 0.15 * torch.rand(2, 20000, generator=g, dtype=D)).to(dtype)
+    t = torch.tensor([2.0, 3.5], dtype=D)
+    c = wf.sample_unchecked(x, y, t, fp, False, True, slopes=False)["crest"]
+    w = whitecap_fraction(torch.tensor(10.0, dtype=dtype))
+
+    def cover():
+        return whitecap_cover(wf, x, y, t, fp, c, wf.crest_variance(fp), wf.crest_variance()[:, None], w, trails=False)
+
+    computed = []
+    read = fs.streak_noise
+    monkeypatch.setattr(wc, "streak_noise", lambda *a, **k: computed.append(read(*a, **k)) or computed[-1])
+    skipped = cover()
+    share = float(torch.cat([(v == 0).flatten() for v in computed]).double().mean())
+    assert share > (0.5 if dtype == torch.float32 else 0.1)
+    assert 0.0 < float((skipped[0] + skipped[1]).mean()) < 0.1
+    monkeypatch.setattr(wc, "_COVER_BLOCK", 1024)
+    blocks = cover()
+    _full_noise(monkeypatch)
+    full = cover()
+    for s, b, f in zip(skipped, blocks, full):
+        assert torch.equal(s, f) and torch.equal(b, f)
+
+
+def test_first_hit_render_is_unchanged_by_skipping_the_streaks(monkeypatch):
+    """A first-hit render (the sweep's samples, and the flat point's covers) with foam, 10 m/s, 15 m mast
+    6° down, float32, is bitwise the render with the streak field read at every sample. An end-to-end
+    guard: a bound that skips points whose cover would be below 1e-7 leaves a float32 render as it is
+    (the test above catches those); fails with the bound 3 units of ν too high (planted)."""
+    cams = make_cams(40, 48, hfov_deg=12.0, altitude_m=15.0, pitch_deg=-6.0, dtype=torch.float32)
+    scene = rs.SeaScene(wind_speed=10.0, sea_temperature=290.0, seed=11, time_s=3.0)
+    table = rs.TableSize(texture_hit="first")
+    skipped = rs.render(cams, scene, table=table)
+    _full_noise(monkeypatch)
+    assert torch.equal(rs.render(cams, scene, table=table), skipped)
