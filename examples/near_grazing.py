@@ -8,8 +8,9 @@ renders side by side:
 - the default textured sea (``TableSize()``: each pixel meets the resolved waves at its flat-sea point);
 - the first hit (``TableSize(texture_hit="first")``: crests hide what lies behind them, with the resolved
   tilt across the view), the paper's Eq. 5 for the unresolved part;
-- the first hit with ``SeaScene(shadowing="correlated")``, the configuration that meets a brute-force ray
-  trace of the same waves best (``docs/texture_vs_raytrace_first_correlated.md``).
+- the expectation and the first hit with ``SeaScene(shadowing="multiscale")`` (the short waves on the
+  backs of longer ones hidden), the configuration whose clutter and mean meet a brute-force ray trace of
+  the same waves best (``docs/texture_vs_raytrace_first_multiscale_raymultiscale.md``).
 
 Writes ``near_grazing.png`` to ``--out`` (one colour range per row, the sea pixels' 0.5–99.5 %) and prints
 each render's time.
@@ -48,7 +49,8 @@ def main() -> None:
         cases = [("expectation", rs.SeaScene(**kw), rs.TableSize()),
                  ("textured, flat point (default)", rs.SeaScene(**kw, seed=5, time_s=3.0), rs.TableSize()),
                  ("first hit", rs.SeaScene(**kw, seed=5, time_s=3.0), first),
-                 ("first hit, correlated shadowing", rs.SeaScene(**kw, seed=5, time_s=3.0, shadowing="correlated"), first)]
+                 ("expectation, multiscale masking", rs.SeaScene(**kw, shadowing="multiscale"), rs.TableSize()),
+                 ("first hit, multiscale masking", rs.SeaScene(**kw, seed=5, time_s=3.0, shadowing="multiscale"), first)]
         row = []
         for name, scene, table in cases:
             t0 = time.perf_counter()
@@ -62,7 +64,7 @@ def main() -> None:
         images.append(row)
         ranges += [(lo, hi)] * len(cases)
     save_grid(torch.cat(images), titles, args.out / "near_grazing.png", label="brightness temperature [K]",
-              ranges=ranges, note="one colour range per row (0.5–99.5 % of its sea pixels)")
+              ranges=ranges, ncols=len(cases), note="one colour range per row (0.5–99.5 % of its sea pixels)")
     print(f"wrote {args.out}/near_grazing.png")
 
 
