@@ -39,13 +39,13 @@ away (ν < 0, the texture's outer nodes near grazing) continues it smoothly (wei
 over the facets still facing the sensor), so values and gradients stay finite and continuous.
 
 Assumptions: the slopes are Gaussian and every scale is masked relative to the longer ones only
-(Smith's uncorrelated masking within a scale); the limit of many scales is taken (with octave
-scales the cascade lies within 3 % of it, ``docs/shadowing.md``). The correlation of the along- and
-across-view slopes enters only through Σ (the mirror image), exactly. Against a brute-force ray
-tracer of the package's own wave fields (the first hit of rays on every band up to 64 rad/m, Eq. 5
-beyond), the ensemble mean near grazing (80–88.4°, 5–15 m/s, upwind and crosswind) departs from
-Eq. 5 by up to −0.40 K; this cascade over the same bands reproduces it to 0.05 K in 33 of 36 bins
-(``docs/shadowing.md``, ``pipelines/shadowing_mean.py``).
+(Smith's uncorrelated masking within a scale); the limit of many scales is taken (a chain with one
+Smith stage per octave masks somewhat less, ``docs/shadowing.md``). The along-view density is exact
+whatever the scales' covariances; the across-view slopes keep their Gaussian law given the along-view
+one (the mirror image in the metric of Σ) when every scale's covariance has the same shape, Σ_k ∝ Σ.
+Where the spreading differs between long and short waves, the across-view law conditioned by the
+cascade departs from this one (a second-order term for the radiance; not modelled). Its comparison
+with a brute-force ray tracer of the package's own wave fields is in ``docs/shadowing.md``.
 
 Sources: B. G. Smith, *Geometrical shadowing of a random rough surface*, IEEE TAP 15(5), 668–671,
 1967 (the masking of one scale); the two-scale sea of E. Bruneton, F. Neyret & N. Holzschuch,
