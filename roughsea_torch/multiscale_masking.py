@@ -35,8 +35,10 @@ leaning towards the sensor gain weight (Q → 1 for x + ν ≫ 1/ν), those near
 (ν → 0⁺) the seen slopes tend to the density 2 x² φ(x) on x > 0 (facets at grazing incidence on the
 mean plane carry no weight, unlike Eq. 5's), so Q takes ν no smaller than ``NU_FLOOR`` = 1e-6: ν = 0
 (θ̂ = 90° on an untilted sea) gives that limit, not 0/0, and a resolved tilt that turns the mean plane
-away (ν < 0, the texture's outer nodes near grazing) continues it smoothly (weight ∝ t (x + ν_floor) φ
-over the facets still facing the sensor), so values and gradients stay finite and continuous.
+away (ν < 0, the texture's outer nodes near grazing) continues it (weight ∝ t (x + ν_floor) φ over the
+facets still facing the sensor; a convention, the cascade itself sees nothing when it starts turned
+away), so values stay finite and continuous and gradients finite. The gradients are not continuous:
+the derivative in ν jumps at ν = ``NU_FLOOR`` (``docs/shadowing.md``).
 
 Assumptions: the slopes are Gaussian and every scale is masked relative to the longer ones only
 (Smith's uncorrelated masking within a scale); the limit of many scales is taken (a chain with one
