@@ -35,17 +35,19 @@ leaning towards the sensor gain weight (Q → 1 for x + ν ≫ 1/ν), those near
 (ν → 0⁺) the seen slopes tend to the density 2 x² φ(x) on x > 0 (facets at grazing incidence on the
 mean plane carry no weight, unlike Eq. 5's), so Q takes ν no smaller than ``NU_FLOOR`` = 1e-6: ν = 0
 (θ̂ = 90° on an untilted sea) gives that limit, not 0/0, and a resolved tilt that turns the mean plane
-away (ν < 0, the texture's outer nodes near grazing) continues it smoothly (weight ∝ t (x + ν_floor) φ
-over the facets still facing the sensor), so values and gradients stay finite and continuous.
+away (ν < 0, the texture's outer nodes near grazing) continues it (weight ∝ t (x + ν_floor) φ over the
+facets still facing the sensor; a convention, the cascade itself sees nothing when it starts turned
+away), so values stay finite and continuous and gradients finite. The gradients are not continuous:
+the derivative in ν jumps at ν = ``NU_FLOOR`` (``docs/shadowing.md``).
 
 Assumptions: the slopes are Gaussian and every scale is masked relative to the longer ones only
-(Smith's uncorrelated masking within a scale); the limit of many scales is taken (with octave
-scales the cascade lies within 3 % of it, ``docs/shadowing.md``). The correlation of the along- and
-across-view slopes enters only through Σ (the mirror image), exactly. Against a brute-force ray
-tracer of the package's own wave fields (the first hit of rays on every band up to 64 rad/m, Eq. 5
-beyond), the ensemble mean near grazing (80–88.4°, 5–15 m/s, upwind and crosswind) departs from
-Eq. 5 by up to −0.40 K; this cascade over the same bands reproduces it to 0.05 K in 33 of 36 bins
-(``docs/shadowing.md``, ``pipelines/shadowing_mean.py``).
+(Smith's uncorrelated masking within a scale); the limit of many scales is taken (a chain with one
+Smith stage per octave masks somewhat less, ``docs/shadowing.md``). The along-view density is exact
+whatever the scales' covariances; the across-view slopes keep their Gaussian law given the along-view
+one (the mirror image in the metric of Σ) when every scale's covariance has the same shape, Σ_k ∝ Σ.
+Where the spreading differs between long and short waves, the across-view law conditioned by the
+cascade departs from this one (a second-order term for the radiance; not modelled). Its comparison
+with a brute-force ray tracer of the package's own wave fields is in ``docs/shadowing.md``.
 
 Sources: B. G. Smith, *Geometrical shadowing of a random rough surface*, IEEE TAP 15(5), 668–671,
 1967 (the masking of one scale); the two-scale sea of E. Bruneton, F. Neyret & N. Holzschuch,
@@ -53,8 +55,9 @@ Sources: B. G. Smith, *Geometrical shadowing of a random rough surface*, IEEE TA
 Graphics Forum 29(2), 2010 (the long waves tilt the short ones' statistics); J. L. Doob, *Conditional
 Brownian motion and the boundary limits of harmonic functions*, Bull. SMF 85, 431–458, 1957
 (h-transforms); D. Revuz & M. Yor, *Continuous Martingales and Brownian Motion*, Springer, 3rd ed.
-1999, ch. VI §3 and ch. XI (the Bessel-3 process as Brownian motion conditioned to stay positive; the
-reflection principle). The numpy reference is :func:`roughsea_torch.reference.rough_sea.masking_weight`.
+1999, ch. XI (Bessel processes; the three-dimensional one as Brownian motion conditioned to stay
+positive); I. Karatzas & S. E. Shreve, *Brownian Motion and Stochastic Calculus*, Springer, 2nd ed. 1991,
+§2.6 (the reflection principle). The numpy reference is :func:`roughsea_torch.reference.rough_sea.masking_weight`.
 """
 
 from __future__ import annotations

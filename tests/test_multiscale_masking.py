@@ -8,7 +8,7 @@
    Eq. 5 recovered where masking vanishes; near grazing the facets seen face the sensor more than
    Eq. 5's, so the emissivity rises, more than with the correlated masking.
 3. The torch option against the numpy reference (emissivity and Eq. 10, zero and shifted means, at
-   the horizon).
+   the horizon, and a tilt that turns the mean plane away: the continuation below the ν floor).
 4. Guarantees of the torch code: finite values and gradients at the extremes (grazing, horizon, calm
    sea, steep anisotropy, a resolved tilt turning the mean plane away), continuity through the
    horizon's limit, batching, a ValueError naming ``shadowing``.
@@ -132,7 +132,8 @@ def test_seen_facets_face_the_sensor_more_near_grazing(backend):
 # ------------------------------------------------------------------------------------------------
 REF_CASES = ((85.0, 0.3, (0.15, 0.12, 0.1), (0.0, 0.0)), (88.0, 0.0, (0.2, 0.16, 0.0), (0.0, 0.0)),
              (87.0, 1.0, (0.1, 0.12, 0.0), (0.03, -0.05)), (86.0, 0.2, (0.1, 0.08, 0.2), (-0.06, 0.01)),
-             (90.0, 0.5, (0.12, 0.1, 0.0), (0.0, 0.0)))
+             (90.0, 0.5, (0.12, 0.1, 0.0), (0.0, 0.0)),
+             (87.0, 0.0, (0.1, 0.1, 0.0), (-0.1, 0.0)))  # the last: a tilt turning the mean plane away, ν = −0.48
 
 
 @pytest.fixture(scope="module")
