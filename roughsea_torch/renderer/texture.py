@@ -28,8 +28,8 @@ from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
-from .hits import (Sweep, covers, flat_nonzero, footprint_fade, pixel_hits, pixel_windows, read_at, sample_step,
-                   sweep_envelope, sweep_layout, track_windows, visible_samples)
+from .hits import (BLOCK, Sweep, covers, flat_nonzero, footprint_fade, in_blocks, pixel_hits, pixel_windows, read_at,
+                   sample_step, sweep_envelope, sweep_layout, track_windows, visible_samples)
 from .path import path_rows
 from .scene import SceneParameters
 from .sky_terms import sky_per_image
@@ -470,23 +470,30 @@ class TextureTable:
         pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731  (faster than v[idx] on CPU)
         Xv, Yv, fv = pick(X, sel)[None], pick(Y, sel)[None], pick(fpk, row)[None]
         smp = wf.sample_unchecked(Xv, Yv, t_s, fv, elevation=False, crest=crest)
-        cov = wf.resolved_covariance(fpk[None])  # 3 of (1, ns)
-        cov_k = tuple(c[0] for c in cov)
+        cov_k = tuple(c[0] for c in wf.resolved_covariance(fpk[None]))  # 3 of (ns,)
         cx, sx = torch.cos(sw.az), torch.sin(sw.az)  # the tracks' ray directions (camera → sea)
-        cov_v, cx_v, sx_v = tuple(pick(c, row) for c in cov_k), pick(cx, col), pick(sx, col)
-        x_v = resolved_quantile(smp["slope_x"][0], smp["slope_y"][0], cov_v, cx_v, sx_v)
         # each sample's row in the volume: ζ of its flat view zenith (the local vertical tilts by r/R)
         t0 = sw.flat_depression()
         cos_k = torch.sin(torch.atan(t0) + 2.0 * sw.curv * sw.r).clamp(1e-9, 1.0)
         zeta_k = torch.asinh(cos_k.double() / self.eps[im]).to(dtype)
-        gy = pick((2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez), row)
-        o = pick(coordinate(cx[None, None, :], sx[None, None, :], i), col)
-        read = self._read_volume(vol[i:i + 1], x_v[None, None], o[None, None], gy[None, None], a[i:i + 1],
-                                 b[i:i + 1])[0, :, 0]  # (C, P)
-        values = [read[0]]
-        if self.cross:  # + g y + h (y² − 1), y the across-view residual of the resolved slope over its rms
-            y = _across_quantile(smp["slope_x"][0], smp["slope_y"][0], cov_v, cx_v, sx_v, x_v)
-            values = [read[0] + read[-2] * y + read[-1] * (y * y - 1.0)]
+        gy_k = (2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez)
+        o_t = coordinate(cx[None, None, :], sx[None, None, :], i)
+
+        def block(u: int, e: int) -> tuple:  # the texture and x at the read samples u:e
+            r_, c_, s_x, s_y = row[u:e], col[u:e], smp["slope_x"][0, u:e], smp["slope_y"][0, u:e]
+            cov_v, cx_v, sx_v = tuple(pick(c, r_) for c in cov_k), pick(cx, c_), pick(sx, c_)
+            x_v = resolved_quantile(s_x, s_y, cov_v, cx_v, sx_v)
+            read = self._read_volume(vol[i:i + 1], x_v[None, None], pick(o_t, c_)[None, None], pick(gy_k, r_)[None, None],
+                                     a[i:i + 1], b[i:i + 1])[0, :, 0]  # (C, e − u)
+            if not self.cross:
+                return read[0], x_v
+            # + g y + h (y² − 1), y the across-view residual of the resolved slope over its rms
+            y = _across_quantile(s_x, s_y, cov_v, cx_v, sx_v, x_v)
+            return read[0] + read[-2] * y + read[-1] * (y * y - 1.0), x_v
+
+        grad = torch.is_grad_enabled() and any(v.requires_grad for v in (vol, smp["slope_x"], cov_k[0], gy_k, o_t, a, b))
+        tex, x_v = in_blocks(block, sel.numel(), max(sel.numel(), 1) if grad else BLOCK)  # (whole with a graph)
+        values = [tex]
         if crest:
             var_r = pick(wf.crest_variance(fpk[None]), row)[None]
             f_act, f_res = whitecap_cover(wf, Xv, Yv, t_s, fv, smp["crest"], var_r, wf.crest_variance()[:, None],
