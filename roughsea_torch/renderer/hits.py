@@ -312,36 +312,47 @@ def _first_below(m: torch.Tensor, j: torch.Tensor, *taus: torch.Tensor) -> list[
     return list(out.unbind(1))
 
 
+def _element_sums(m: torch.Tensor, values: torch.Tensor, out: torch.Tensor, tracks: int = 4) -> torch.Tensor:
+    """F (C, nt, ns) into ``out`` (which may be ``values`` itself): F[..., k] = Σ_{e<k} span_e el_e, with
+    el_e = (v_e + v_e+1)/2 the element's mean and span_e = m_e − m_e+1 the depressions it covers (0 where
+    hidden), one cumulative sum over a leading 0 (0 + 0 = 0 exactly); a few ``tracks`` at a time, so
+    that the products stay in cache and no second array of the values' size is needed."""
+    nt = values.shape[1]
+    for a in range(0, nt, tracks):
+        s = slice(a, a + tracks)
+        prod = torch.add(values[:, s, 1:], values[:, s, :-1]).mul_(0.5).mul_((m[s, :-1] - m[s, 1:]).to(values.dtype))
+        out[:, s, 0] = 0.0
+        out[:, s, 1:] = prod
+        out[:, s].cumsum_(-1)
+    return out
+
+
 def _window_average(m: torch.Tensor, values: torch.Tensor, j: torch.Tensor, tau_top: torch.Tensor,
-                    tau_bottom: torch.Tensor, k_top: torch.Tensor, k_bottom: torch.Tensor) -> torch.Tensor:
-    """:func:`visible_average` given the first samples below each window's edges (:func:`_first_below`).
-
-    F[k] = Σ_{e<k} span_e el_e, el_e = (v_e + v_e+1)/2 the element's mean and span_e = m_e − m_e+1 the
-    depressions it covers (0 where hidden), as one cumulative sum over a leading 0 (F[0] = 0 + ... = 0
-    exactly); the elements' means are recomputed (the same two operations) only where a window's
-    edge falls."""
+                    tau_bottom: torch.Tensor, k_top: torch.Tensor, k_bottom: torch.Tensor,
+                    overwrite: bool = False) -> torch.Tensor:
+    """:func:`visible_average` given the first samples below each window's edges (:func:`_first_below`),
+    from the cumulative sums F of :func:`_element_sums`; ``overwrite``: F takes the buffer of ``values``
+    (without a graph), whose elements' means at the windows' edges are read before."""
     C, nt, ns = values.shape
-    span = (m[:, :-1] - m[:, 1:]).to(values.dtype)  # the depressions an element covers (0 where hidden)
-    v_, m_ = values.reshape(C, -1), m.reshape(-1)  # read by flat index_select (CPU: faster)
-    if torch.is_grad_enabled() and (values.requires_grad or span.requires_grad):
+    m_ = m.reshape(-1)  # (read by flat index_select: faster on the CPU)
+    edges = [(tau, k, j * ns + (k - 1).clamp(0, ns - 2)) for tau, k in ((tau_top, k_top), (tau_bottom, k_bottom))]
+    if torch.is_grad_enabled() and (values.requires_grad or m.requires_grad):
         el = 0.5 * (values[..., 1:] + values[..., :-1])  # (C, nt, ns − 1)
+        span = (m[:, :-1] - m[:, 1:]).to(values.dtype)
         F = torch.cat([torch.zeros_like(el[..., :1]), torch.cumsum(span * el, -1)], -1)
-        element = lambda at: el.reshape(C, -1).index_select(1, at - j)  # noqa: E731  (flat (j, e))
-    else:  # (in place: one buffer of the values' size instead of four)
-        F = values.new_zeros((C, nt, ns))
-        torch.add(values[..., 1:], values[..., :-1], out=F[..., 1:]).mul_(0.5).mul_(span)
-        F = F.cumsum_(-1)
-        element = lambda at: 0.5 * (v_.index_select(1, at + 1) + v_.index_select(1, at))  # noqa: E731
+        els = [el.reshape(C, -1).index_select(1, at - j) for _, _, at in edges]  # (flat (j, e))
+    else:  # (the same two operations at the edges only)
+        v_ = values.reshape(C, -1)
+        els = [0.5 * (v_.index_select(1, at + 1) + v_.index_select(1, at)) for _, _, at in edges]
+        F = _element_sums(m, values, values if overwrite else torch.empty_like(values))
     F_ = F.reshape(C, -1)
-
-    def integral(tau: torch.Tensor, k: torch.Tensor) -> torch.Tensor:  # F(τ): ∫ over the visible depressions ≥ τ
-        e = (k - 1).clamp(0, ns - 2)  # element e = k − 1 holds τ (m[e + 1] ≤ τ ≤ m[e])
-        inside = (k > 0) & (k < ns)
-        at = j * ns + e
-        part = F_.index_select(1, at) + (m_.index_select(0, at).to(values.dtype) - tau) * element(at)
-        return torch.where(inside, part, torch.where(k >= ns, F_.index_select(1, j * ns + ns - 1), torch.zeros_like(part)))
-
-    return (integral(tau_top, k_top) - integral(tau_bottom, k_bottom)) / (tau_bottom - tau_top)
+    parts = []
+    for (tau, k, at), el in zip(edges, els):  # F(τ): ∫ over the visible depressions ≥ τ
+        inside = (k > 0) & (k < ns)  # element e = k − 1 holds τ (m[e + 1] ≤ τ ≤ m[e])
+        part = F_.index_select(1, at) + (m_.index_select(0, at).to(values.dtype) - tau) * el
+        parts.append(torch.where(inside, part, torch.where(k >= ns, F_.index_select(1, j * ns + ns - 1),
+                                                           torch.zeros_like(part))))
+    return (parts[0] - parts[1]) / (tau_bottom - tau_top)
 
 
 def visible_average(m: torch.Tensor, values: torch.Tensor, j: torch.Tensor, tau_top: torch.Tensor,
@@ -365,10 +376,11 @@ def centre_element(m: torch.Tensor, j: torch.Tensor, tau: torch.Tensor) -> tuple
 
 
 def pixel_hits(m: torch.Tensor, values: torch.Tensor, j: torch.Tensor, tau_top: torch.Tensor, tau_bottom: torch.Tensor,
-               tau: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+               tau: torch.Tensor, overwrite: bool = False) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """:func:`visible_average` over the windows [τ_top, τ_bottom] and :func:`centre_element` of the centre
-    rays τ together, from one search: (average (C, P), k (P,), hit (P,))."""
+    rays τ together, from one search: (average (C, P), k (P,), hit (P,)). ``overwrite``: ``values`` is not
+    needed afterwards, its buffer may hold the cumulative sums (where no graph is kept)."""
     k_top, k_bottom, k = _first_below(m, j, tau_top, tau_bottom, tau)
     ns = m.shape[1]
-    return (_window_average(m, values, j, tau_top, tau_bottom, k_top, k_bottom), k.clamp(1, ns - 1),
+    return (_window_average(m, values, j, tau_top, tau_bottom, k_top, k_bottom, overwrite), k.clamp(1, ns - 1),
             (k > 0) & (k < ns))

@@ -394,7 +394,7 @@ class TextureTable:
             on = flat_nonzero(g.detach() > 0)  # (the pixels that take the sweep's texture)
             window = track_windows(sw.shape[1], j.index_select(0, on), tau_t.index_select(0, on), tau_b.index_select(0, on))
             values, x_k, cov_k = self._swept_samples(im, i, wf, sw, m, window, vol, lo, span_z, a, b, coordinate, crest)
-            avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g)
+            avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g, overwrite=True)
             texture[i] = texture[i].index_put((s,), g * avg[0])
             if crest:  # the active and residual covers
                 for c in range(2):
