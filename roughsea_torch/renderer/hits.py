@@ -67,7 +67,7 @@ import torch
 from ..clutter import footprint
 from ..wave_bands import band_window
 
-__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "running_minimum", "track_windows", "covers", "visible_samples", "flat_nonzero", "BLOCK", "in_blocks", "read_at", "pixel_windows", "visible_average",
+__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "running_minimum", "track_windows", "covers", "visible_samples", "flat_nonzero", "nonzero_2d", "BLOCK", "in_blocks", "read_at", "pixel_windows", "visible_average",
            "centre_element", "pixel_hits", "sample_step", "footprint_fade"]
 
 
@@ -186,8 +186,11 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     dphi = ifov / tracks
     nt = int(math.ceil((p1 - p0) / dphi)) + 1
     az = p0 + dphi * torch.arange(nt, dtype=dtype, device=device)
-    x = centre[0].to(dtype) + r[:, None] * torch.cos(az)[None, :]
-    y = centre[1].to(dtype) + r[:, None] * torch.sin(az)[None, :]
+    cen = centre.to(dtype)
+    if torch.is_grad_enabled() and cen.requires_grad:
+        x, y = cen[0] + r[:, None] * torch.cos(az)[None, :], cen[1] + r[:, None] * torch.sin(az)[None, :]
+    else:  # (the products' own arrays: c + r cos φ = r cos φ + c)
+        x, y = (r[:, None] * torch.cos(az)[None, :]).add_(cen[0]), (r[:, None] * torch.sin(az)[None, :]).add_(cen[1])
     rho = torch.sqrt(r * r + hf * hf)
     scale = 2.0 * torch.as_tensor(sample_step(np.sin(gam), step, min_step, across), dtype=dtype, device=device)
     fp = footprint(rho, hf / rho, ifov * scale)
@@ -284,6 +287,18 @@ def read_at(index: torch.Tensor, values: torch.Tensor, at: torch.Tensor) -> torc
     found = index.index_select(0, pos.reshape(-1)).reshape(at.shape) == at
     got = values.index_select(0, pos.reshape(-1)).reshape(at.shape)
     return torch.where(found, got, torch.zeros_like(got))
+
+
+def nonzero_2d(mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """(flat, row, col): the True elements of a 2-D bool tensor (R, W) in row-major order, as flat indices
+    (row · W + col) and as rows and columns, int64 (:func:`flat_nonzero`; on the CPU the rows and columns
+    from numpy's ``divmod``, ~3× faster than torch's integer division there)."""
+    flat, w = flat_nonzero(mask), mask.shape[1]
+    if flat.device.type == "cpu":
+        row, col = np.divmod(flat.numpy(), w)
+        return flat, torch.from_numpy(row), torch.from_numpy(col)
+    row = torch.div(flat, w, rounding_mode="floor")
+    return flat, row, flat - row * w
 
 
 def pixel_windows(tan_g: torch.Tensor, ifov: float) -> tuple[torch.Tensor, torch.Tensor]:

@@ -28,8 +28,8 @@ from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
-from .hits import (BLOCK, Sweep, covers, flat_nonzero, footprint_fade, in_blocks, pixel_hits, pixel_windows, read_at,
-                   sample_step, sweep_envelope, sweep_layout, track_windows, visible_samples)
+from .hits import (BLOCK, Sweep, covers, flat_nonzero, footprint_fade, in_blocks, nonzero_2d, pixel_hits, pixel_windows,
+                   read_at, sample_step, sweep_envelope, sweep_layout, track_windows, visible_samples)
 from .path import path_rows
 from .scene import SceneParameters
 from .sky_terms import sky_per_image
@@ -464,9 +464,7 @@ class TextureTable:
         fpk = sw.footprint / self.hit_visibility  # (ns,) the node values' footprint F_s
         X, Y, t_s = sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1]
         # the samples read, sample-major (ns, nt)
-        sel = flat_nonzero(visible_samples(m.T, dim=0, window=(window[0][None, :], window[1][None, :])))
-        row = torch.div(sel, nt, rounding_mode="floor")
-        col = sel - row * nt
+        sel, row, col = nonzero_2d(visible_samples(m.T, dim=0, window=(window[0][None, :], window[1][None, :])))
         pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731  (faster than v[idx] on CPU)
         Xv, Yv, fv = pick(X, sel)[None], pick(Y, sel)[None], pick(fpk, row)[None]
         smp = wf.sample_unchecked(Xv, Yv, t_s, fv, elevation=False, crest=crest)
