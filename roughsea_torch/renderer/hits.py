@@ -204,9 +204,9 @@ def sweep_envelope(sweep: Sweep, eta: torch.Tensor) -> tuple[torch.Tensor, torch
     top = (sweep.h + sweep.curv * r * r)[None, :]
     if torch.is_grad_enabled() and (eta.requires_grad or top.requires_grad):
         t = ((top - eta.T) / r[None, :]).contiguous()
-    else:  # (written in the tracks' layout straight away: no transposed copy)
-        out = torch.empty(eta.shape[::-1], dtype=torch.result_type(top, eta), device=eta.device)
-        t = torch.sub(top, eta.T, out=out).div_(r[None, :])
+    else:  # (in place on η's copy in the tracks' layout: a blocked transpose, then contiguous passes)
+        t = eta.T.to(torch.result_type(top, eta), copy=True, memory_format=torch.contiguous_format)
+        t = torch.sub(top, t, out=t).div_(r[None, :])
     return t, running_minimum(t.detach())
 
 
