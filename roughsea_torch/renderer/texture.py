@@ -498,7 +498,7 @@ class TextureTable:
                                           self.p.foam[im:im + 1].to(dtype)[:, None], trails=self.foam_trails)
             values += [f_act[0], f_res[0]]
         # back to every sample (0 at the hidden ones), in the (nt, ns) layout of the envelope, row by row
-        full, at = x_v.new_zeros(len(values), nt * ns), col * ns + row
+        full, at = x_v.new_zeros(len(values), nt * ns), (col * ns).add_(row)
         for c, v in enumerate(values):
             full[c].index_copy_(0, at, v)
         return full.reshape(-1, nt, ns), (sel, x_v), cov_k
