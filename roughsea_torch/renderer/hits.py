@@ -67,7 +67,8 @@ import torch
 from ..clutter import footprint
 from ..wave_bands import band_window
 
-__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "running_minimum", "track_windows", "covers", "visible_samples", "flat_nonzero", "nonzero_2d", "BLOCK", "in_blocks", "read_at", "pixel_windows", "visible_average",
+__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "running_minimum", "track_windows", "covers", "visible_samples",
+           "flat_nonzero", "nonzero_2d", "BLOCK", "in_blocks", "read_at", "pixel_windows", "visible_average",
            "centre_element", "pixel_hits", "sample_step", "footprint_fade"]
 
 
@@ -359,7 +360,8 @@ def _window_average(m: torch.Tensor, values: torch.Tensor, j: torch.Tensor, tau_
     else:  # (the same two operations at the edges only)
         v_ = values.reshape(C, -1)
         els = [0.5 * (v_.index_select(1, at + 1) + v_.index_select(1, at)) for _, _, at in edges]
-        F = _element_sums(m, values, values if overwrite else torch.empty_like(values))
+        own = overwrite and values.is_contiguous()  # (an expanded tensor shares its elements)
+        F = _element_sums(m, values, values if own else values.new_empty(values.shape))
     F_ = F.reshape(C, -1)
     parts = []
     for (tau, k, at), el in zip(edges, els):  # F(τ): ∫ over the visible depressions ≥ τ

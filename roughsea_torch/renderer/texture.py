@@ -453,12 +453,14 @@ class TextureTable:
                        lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any,
                        crest: bool) -> tuple:
         """At the sweep's samples of image ``im`` (chunk index ``i``), given its running minimum m (nt, ns)
-        (:meth:`_swept_envelope`): the texture and foam fraction (C, nt, ns), the resolved quantiles x and the resolved covariance (3 of (ns,)). The slopes, the crest variable, the texture and
-        the foam are read only at the visible samples within the depressions ``window`` = (lo, hi) (nt,)
-        that the track's pixels see (:func:`visible_samples`: near grazing about half the samples are
-        hidden, and the sweep starts where the steepest ray might meet a crest of η_max, before the
-        windows), 0 elsewhere. The quantiles x come as (the read samples' flat indices, sample-major (ns, nt),
-        ascending; x at each), for :func:`~roughsea_torch.renderer.hits.read_at`."""
+        (:meth:`_swept_envelope`): the texture and foam fraction (C, nt, ns), the resolved quantiles x and
+        the resolved covariance (3 of (ns,)). The slopes, the crest variable, the texture and the foam are
+        read only at the visible samples within the depressions ``window`` = (lo, hi) (nt,) that the
+        track's pixels see (:func:`visible_samples`: near grazing about half the samples are hidden, and
+        the sweep starts where the steepest ray might meet a crest of η_max, before the windows), 0
+        elsewhere; their per-point work in blocks (:func:`~roughsea_torch.renderer.hits.in_blocks`). The
+        quantiles x come as (the read samples' flat indices, sample-major (ns, nt), ascending; x at each),
+        for :func:`~roughsea_torch.renderer.hits.read_at`."""
         dtype = self.dtype
         ns, nt = sw.shape
         fpk = sw.footprint / self.hit_visibility  # (ns,) the node values' footprint F_s
