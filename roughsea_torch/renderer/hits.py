@@ -14,7 +14,7 @@ Method (the running horizon of height-field renderers, applied to the sea):
 - With the running minimum m(r) = min over r' ≤ r of t(r') (it never increases), a ray of depression
   τ first meets the surface at the first r where m(r) ≤ τ; the surface between two samples r_k, r_k+1
   is seen over the depressions [m_k+1, m_k] (none where it is hidden, m_k+1 = m_k). One sweep of a
-  track (η at its samples, then ``cummin``) serves every pixel on it, whatever its depression.
+  track (η at its samples, then the running minimum) serves every pixel on it, whatever its depression.
 - A pixel covers the depressions [τ_top, τ_bottom] of its upper and lower edges. It sees the visible
   pieces of the track that fall in that interval, each in proportion to its angular size, so its
   texture is the angular average of the texture along its visible pieces (a box filter in depression,
@@ -213,8 +213,8 @@ def sweep_envelope(sweep: Sweep, eta: torch.Tensor) -> tuple[torch.Tensor, torch
 
 def running_minimum(t: torch.Tensor) -> torch.Tensor:
     """The running minimum of t (nt, ns) along its last axis, m[:, k] = min over k' ≤ k of t[:, k'] (a
-    new tensor): numpy's ``minimum.accumulate`` on the CPU (no index tensor, ~1.6× faster than
-    ``torch.cummin`` there), ``torch.cummin`` elsewhere; the same values (a minimum rounds nothing)."""
+    new tensor): numpy's ``minimum.accumulate`` on the CPU (it writes no index tensor, as ``torch.cummin``
+    does), ``torch.cummin`` elsewhere; the same values (a minimum rounds nothing)."""
     if t.device.type == "cpu" and not t.requires_grad:
         return torch.from_numpy(np.minimum.accumulate(t.numpy(), axis=-1))
     return torch.cummin(t, dim=-1).values
@@ -271,8 +271,7 @@ BLOCK = 1 << 15  # points per block of per-point work (:func:`in_blocks`)
 def in_blocks(fn: Any, n: int, block: int = BLOCK) -> tuple:
     """``fn(u, e)`` on the blocks [u, e) of ``n`` points, ``block`` at a time, its outputs (tensors whose last
     axis runs over the block's points) joined along that axis: per-point work done a block at a time keeps
-    its temporaries in cache (on 4.7 M points the resolved quantiles took 2.6× less time in blocks of 2¹⁵).
-    The same values as one call on all the points when ``fn`` is pointwise."""
+    its temporaries in cache. The same values as one call on all the points when ``fn`` is pointwise."""
     parts = [fn(u, min(n, u + block)) for u in range(0, max(n, 1), block)]
     return tuple(p[0] if len(p) == 1 else torch.cat(p, -1) for p in zip(*parts))
 
@@ -293,7 +292,7 @@ def read_at(index: torch.Tensor, values: torch.Tensor, at: torch.Tensor) -> torc
 def nonzero_2d(mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """(flat, row, col): the True elements of a 2-D bool tensor (R, W) in row-major order, as flat indices
     (row · W + col) and as rows and columns, int64 (:func:`flat_nonzero`; on the CPU the rows and columns
-    from numpy's ``divmod``, ~3× faster than torch's integer division there)."""
+    from numpy's ``divmod``, faster there than torch's integer division)."""
     flat, w = flat_nonzero(mask), mask.shape[1]
     if flat.device.type == "cpu":
         row, col = np.divmod(flat.numpy(), w)
