@@ -98,7 +98,8 @@ class Stages:
 
     WRAPPED = {"layout (sample points)": "sweep_layout", "envelope (running minimum)": "sweep_envelope",
                "visible samples": "visible_samples", "pixels' windows: search and average": "pixel_hits",
-               "quantile x at the samples": "resolved_quantile", "foam at the samples": "whitecap_cover"}
+               "quantile x at the samples": "resolved_quantile", "across-view quantile y at the samples": "_across_quantile",
+               "foam at the samples": "whitecap_cover"}
     NESTED = "  of which the streak noise"  # (inside "foam at the samples": not added to the stages' sum)
 
     def __init__(self):

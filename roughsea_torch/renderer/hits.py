@@ -14,7 +14,7 @@ Method (the running horizon of height-field renderers, applied to the sea):
 - With the running minimum m(r) = min over r' ≤ r of t(r') (it never increases), a ray of depression
   τ first meets the surface at the first r where m(r) ≤ τ; the surface between two samples r_k, r_k+1
   is seen over the depressions [m_k+1, m_k] (none where it is hidden, m_k+1 = m_k). One sweep of a
-  track (η at its samples, then ``cummin``) serves every pixel on it, whatever its depression.
+  track (η at its samples, then the running minimum) serves every pixel on it, whatever its depression.
 - A pixel covers the depressions [τ_top, τ_bottom] of its upper and lower edges. It sees the visible
   pieces of the track that fall in that interval, each in proportion to its angular size, so its
   texture is the angular average of the texture along its visible pieces (a box filter in depression,
@@ -67,7 +67,8 @@ import torch
 from ..clutter import footprint
 from ..wave_bands import band_window
 
-__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "track_windows", "covers", "visible_samples", "flat_nonzero", "pixel_windows", "visible_average",
+__all__ = ["Sweep", "sweep_layout", "sweep_envelope", "running_minimum", "track_windows", "covers", "visible_samples",
+           "flat_nonzero", "nonzero_2d", "BLOCK", "in_blocks", "read_at", "pixel_windows", "visible_average",
            "centre_element", "pixel_hits", "sample_step", "footprint_fade"]
 
 
@@ -186,8 +187,11 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     dphi = ifov / tracks
     nt = int(math.ceil((p1 - p0) / dphi)) + 1
     az = p0 + dphi * torch.arange(nt, dtype=dtype, device=device)
-    x = centre[0].to(dtype) + r[:, None] * torch.cos(az)[None, :]
-    y = centre[1].to(dtype) + r[:, None] * torch.sin(az)[None, :]
+    cen = centre.to(dtype)
+    if torch.is_grad_enabled() and cen.requires_grad:
+        x, y = cen[0] + r[:, None] * torch.cos(az)[None, :], cen[1] + r[:, None] * torch.sin(az)[None, :]
+    else:  # (the products' own arrays: c + r cos φ = r cos φ + c)
+        x, y = (r[:, None] * torch.cos(az)[None, :]).add_(cen[0]), (r[:, None] * torch.sin(az)[None, :]).add_(cen[1])
     rho = torch.sqrt(r * r + hf * hf)
     scale = 2.0 * torch.as_tensor(sample_step(np.sin(gam), step, min_step, across), dtype=dtype, device=device)
     fp = footprint(rho, hf / rho, ifov * scale)
@@ -198,9 +202,22 @@ def sweep_envelope(sweep: Sweep, eta: torch.Tensor) -> tuple[torch.Tensor, torch
     """(t, m), each (nt, ns): the depressions of the surface's samples (η (ns, nt) [m]) and their
     running minimum along each track (detached: it only chooses elements)."""
     r = sweep.r
-    t = ((sweep.h + sweep.curv * r * r)[:, None] - eta) / r[:, None]
-    t = t.T.contiguous()
-    return t, torch.cummin(t.detach(), dim=1).values
+    top = (sweep.h + sweep.curv * r * r)[None, :]
+    if torch.is_grad_enabled() and (eta.requires_grad or top.requires_grad):
+        t = ((top - eta.T) / r[None, :]).contiguous()
+    else:  # (in place on η's copy in the tracks' layout: a blocked transpose, then contiguous passes)
+        t = eta.T.to(torch.result_type(top, eta), copy=True, memory_format=torch.contiguous_format)
+        t = torch.sub(top, t, out=t).div_(r[None, :])
+    return t, running_minimum(t.detach())
+
+
+def running_minimum(t: torch.Tensor) -> torch.Tensor:
+    """The running minimum of t (nt, ns) along its last axis, m[:, k] = min over k' ≤ k of t[:, k'] (a
+    new tensor): numpy's ``minimum.accumulate`` on the CPU (it writes no index tensor, as ``torch.cummin``
+    does), ``torch.cummin`` elsewhere; the same values (a minimum rounds nothing)."""
+    if t.device.type == "cpu" and not t.requires_grad:
+        return torch.from_numpy(np.minimum.accumulate(t.numpy(), axis=-1))
+    return torch.cummin(t, dim=-1).values
 
 
 def track_windows(nt: int, j: torch.Tensor, tau_top: torch.Tensor, tau_bottom: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
@@ -248,6 +265,42 @@ def flat_nonzero(mask: torch.Tensor) -> torch.Tensor:
     return flat.nonzero().squeeze(1)
 
 
+BLOCK = 1 << 15  # points per block of per-point work (:func:`in_blocks`)
+
+
+def in_blocks(fn: Any, n: int, block: int = BLOCK) -> tuple:
+    """``fn(u, e)`` on the blocks [u, e) of ``n`` points, ``block`` at a time, its outputs (tensors whose last
+    axis runs over the block's points) joined along that axis: per-point work done a block at a time keeps
+    its temporaries in cache. The same values as one call on all the points when ``fn`` is pointwise."""
+    parts = [fn(u, min(n, u + block)) for u in range(0, max(n, 1), block)]
+    return tuple(p[0] if len(p) == 1 else torch.cat(p, -1) for p in zip(*parts))
+
+
+def read_at(index: torch.Tensor, values: torch.Tensor, at: torch.Tensor) -> torch.Tensor:
+    """A quantity known at some flat indices, read at others: ``values`` (N,) at the ascending flat indices
+    ``index`` (N,), read at ``at`` (any shape), 0 where ``at`` is not among them: what the dense array that
+    holds ``values`` at ``index`` and 0 elsewhere gives at ``at``, without that array (one binary search
+    per read)."""
+    if index.numel() == 0:
+        return values.new_zeros(at.shape)
+    pos = torch.searchsorted(index, at.detach()).clamp_(max=index.numel() - 1)
+    found = index.index_select(0, pos.reshape(-1)).reshape(at.shape) == at
+    got = values.index_select(0, pos.reshape(-1)).reshape(at.shape)
+    return torch.where(found, got, torch.zeros_like(got))
+
+
+def nonzero_2d(mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """(flat, row, col): the True elements of a 2-D bool tensor (R, W) in row-major order, as flat indices
+    (row · W + col) and as rows and columns, int64 (:func:`flat_nonzero`; on the CPU the rows and columns
+    from numpy's ``divmod``, faster there than torch's integer division)."""
+    flat, w = flat_nonzero(mask), mask.shape[1]
+    if flat.device.type == "cpu":
+        row, col = np.divmod(flat.numpy(), w)
+        return flat, torch.from_numpy(row), torch.from_numpy(col)
+    row = torch.div(flat, w, rounding_mode="floor")
+    return flat, row, flat - row * w
+
+
 def pixel_windows(tan_g: torch.Tensor, ifov: float) -> tuple[torch.Tensor, torch.Tensor]:
     """(τ_top, τ_bottom): the depressions (tangents) of the upper and lower edges of pixels whose centre
     ray has depression ``tan_g``, δ = ``ifov`` [rad] tall."""
@@ -274,24 +327,48 @@ def _first_below(m: torch.Tensor, j: torch.Tensor, *taus: torch.Tensor) -> list[
     return list(out.unbind(1))
 
 
+def _element_sums(m: torch.Tensor, values: torch.Tensor, out: torch.Tensor, tracks: int = 4) -> torch.Tensor:
+    """F (C, nt, ns) into ``out`` (which may be ``values`` itself): F[..., k] = Σ_{e<k} span_e el_e, with
+    el_e = (v_e + v_e+1)/2 the element's mean and span_e = m_e − m_e+1 the depressions it covers (0 where
+    hidden), one cumulative sum over a leading 0 (0 + 0 = 0 exactly); a few ``tracks`` at a time, so
+    that the products stay in cache and no second array of the values' size is needed."""
+    nt = values.shape[1]
+    for a in range(0, nt, tracks):
+        s = slice(a, a + tracks)
+        prod = torch.add(values[:, s, 1:], values[:, s, :-1]).mul_(0.5).mul_((m[s, :-1] - m[s, 1:]).to(values.dtype))
+        out[:, s, 0] = 0.0
+        out[:, s, 1:] = prod
+        out[:, s].cumsum_(-1)
+    return out
+
+
 def _window_average(m: torch.Tensor, values: torch.Tensor, j: torch.Tensor, tau_top: torch.Tensor,
-                    tau_bottom: torch.Tensor, k_top: torch.Tensor, k_bottom: torch.Tensor) -> torch.Tensor:
-    """:func:`visible_average` given the first samples below each window's edges (:func:`_first_below`)."""
+                    tau_bottom: torch.Tensor, k_top: torch.Tensor, k_bottom: torch.Tensor,
+                    overwrite: bool = False) -> torch.Tensor:
+    """:func:`visible_average` given the first samples below each window's edges (:func:`_first_below`),
+    from the cumulative sums F of :func:`_element_sums`; ``overwrite``: F takes the buffer of ``values``
+    (without a graph), whose elements' means at the windows' edges are read before."""
     C, nt, ns = values.shape
-    el = 0.5 * (values[..., 1:] + values[..., :-1])  # (C, nt, ns − 1)
-    span = (m[:, :-1] - m[:, 1:]).to(el.dtype)  # the depressions an element covers (0 where hidden)
-    F = torch.cat([torch.zeros_like(el[..., :1]), torch.cumsum(span * el, -1)], -1)  # (C, nt, ns)
-
-    F_, el_, m_ = F.reshape(C, -1), el.reshape(C, -1), m.reshape(-1)  # read by flat index_select (CPU: faster)
-
-    def integral(tau: torch.Tensor, k: torch.Tensor) -> torch.Tensor:  # F(τ): ∫ over the visible depressions ≥ τ
-        e = (k - 1).clamp(0, ns - 2)  # element e = k − 1 holds τ (m[e + 1] ≤ τ ≤ m[e])
-        inside = (k > 0) & (k < ns)
-        at = j * ns + e
-        part = F_.index_select(1, at) + (m_.index_select(0, at).to(el.dtype) - tau) * el_.index_select(1, j * (ns - 1) + e)
-        return torch.where(inside, part, torch.where(k >= ns, F_.index_select(1, j * ns + ns - 1), torch.zeros_like(part)))
-
-    return (integral(tau_top, k_top) - integral(tau_bottom, k_bottom)) / (tau_bottom - tau_top)
+    m_ = m.reshape(-1)  # (read by flat index_select: faster on the CPU)
+    edges = [(tau, k, j * ns + (k - 1).clamp(0, ns - 2)) for tau, k in ((tau_top, k_top), (tau_bottom, k_bottom))]
+    if torch.is_grad_enabled() and (values.requires_grad or m.requires_grad):
+        el = 0.5 * (values[..., 1:] + values[..., :-1])  # (C, nt, ns − 1)
+        span = (m[:, :-1] - m[:, 1:]).to(values.dtype)
+        F = torch.cat([torch.zeros_like(el[..., :1]), torch.cumsum(span * el, -1)], -1)
+        els = [el.reshape(C, -1).index_select(1, at - j) for _, _, at in edges]  # (flat (j, e))
+    else:  # (the same two operations at the edges only)
+        v_ = values.reshape(C, -1)
+        els = [0.5 * (v_.index_select(1, at + 1) + v_.index_select(1, at)) for _, _, at in edges]
+        own = overwrite and values.is_contiguous()  # (an expanded tensor shares its elements)
+        F = _element_sums(m, values, values if own else values.new_empty(values.shape))
+    F_ = F.reshape(C, -1)
+    parts = []
+    for (tau, k, at), el in zip(edges, els):  # F(τ): ∫ over the visible depressions ≥ τ
+        inside = (k > 0) & (k < ns)  # element e = k − 1 holds τ (m[e + 1] ≤ τ ≤ m[e])
+        part = F_.index_select(1, at) + (m_.index_select(0, at).to(values.dtype) - tau) * el
+        parts.append(torch.where(inside, part, torch.where(k >= ns, F_.index_select(1, j * ns + ns - 1),
+                                                           torch.zeros_like(part))))
+    return (parts[0] - parts[1]) / (tau_bottom - tau_top)
 
 
 def visible_average(m: torch.Tensor, values: torch.Tensor, j: torch.Tensor, tau_top: torch.Tensor,
@@ -315,10 +392,11 @@ def centre_element(m: torch.Tensor, j: torch.Tensor, tau: torch.Tensor) -> tuple
 
 
 def pixel_hits(m: torch.Tensor, values: torch.Tensor, j: torch.Tensor, tau_top: torch.Tensor, tau_bottom: torch.Tensor,
-               tau: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+               tau: torch.Tensor, overwrite: bool = False) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """:func:`visible_average` over the windows [τ_top, τ_bottom] and :func:`centre_element` of the centre
-    rays τ together, from one search: (average (C, P), k (P,), hit (P,))."""
+    rays τ together, from one search: (average (C, P), k (P,), hit (P,)). ``overwrite``: ``values`` is not
+    needed afterwards, its buffer may hold the cumulative sums (where no graph is kept)."""
     k_top, k_bottom, k = _first_below(m, j, tau_top, tau_bottom, tau)
     ns = m.shape[1]
-    return (_window_average(m, values, j, tau_top, tau_bottom, k_top, k_bottom), k.clamp(1, ns - 1),
+    return (_window_average(m, values, j, tau_top, tau_bottom, k_top, k_bottom, overwrite), k.clamp(1, ns - 1),
             (k > 0) & (k < ns))

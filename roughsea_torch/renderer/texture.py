@@ -28,8 +28,8 @@ from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
-from .hits import (Sweep, covers, flat_nonzero, footprint_fade, pixel_hits, pixel_windows, sample_step, sweep_envelope,
-                   sweep_layout, track_windows, visible_samples)
+from .hits import (BLOCK, Sweep, covers, flat_nonzero, footprint_fade, in_blocks, nonzero_2d, pixel_hits, pixel_windows,
+                   read_at, sample_step, sweep_envelope, sweep_layout, track_windows, visible_samples)
 from .path import path_rows
 from .scene import SceneParameters
 from .sky_terms import sky_per_image
@@ -394,13 +394,14 @@ class TextureTable:
             on = flat_nonzero(g.detach() > 0)  # (the pixels that take the sweep's texture)
             window = track_windows(sw.shape[1], j.index_select(0, on), tau_t.index_select(0, on), tau_b.index_select(0, on))
             values, x_k, cov_k = self._swept_samples(im, i, wf, sw, m, window, vol, lo, span_z, a, b, coordinate, crest)
-            avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g)
+            avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g, overwrite=True)
             texture[i] = texture[i].index_put((s,), g * avg[0])
             if crest:  # the active and residual covers
                 for c in range(2):
                     f_pix[c][i] = f_pix[c][i].index_put((s,), flat[c] + g * avg[1 + c])
             # (x = 0 where g = 0: the pixel resolves nothing, its resolved covariance g² C is 0 too)
-            x_c[i] = x_c[i].index_put((s,), torch.where(hit & (g.detach() > 0), x_k[j, k], torch.zeros_like(tan_g)))
+            x_c[i] = x_c[i].index_put((s,), torch.where(hit & (g.detach() > 0), read_at(*x_k, k * sw.shape[1] + j),
+                                                         torch.zeros_like(tan_g)))
             for c in range(3):  # (g² C: the glint's resolved part fades with the texture)
                 cov_c[c][i] = cov_c[c][i].index_put((s,), g * g * cov_k[c][k])
         return texture, (x_c, x_c), tuple(cov_c), f_pix
@@ -452,51 +453,57 @@ class TextureTable:
                        lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any,
                        crest: bool) -> tuple:
         """At the sweep's samples of image ``im`` (chunk index ``i``), given its running minimum m (nt, ns)
-        (:meth:`_swept_envelope`): the texture and foam fraction (C, nt, ns), the resolved quantiles x
-        (nt, ns) and the resolved covariance (3 of (ns,)). The slopes, the crest variable, the texture and
-        the foam are read only at the visible samples within the depressions ``window`` = (lo, hi) (nt,)
-        that the track's pixels see (:func:`visible_samples`: near grazing about half the samples are
-        hidden, and the sweep starts where the steepest ray might meet a crest of η_max, before the
-        windows), 0 elsewhere."""
+        (:meth:`_swept_envelope`): the texture and foam fraction (C, nt, ns), the resolved quantiles x and
+        the resolved covariance (3 of (ns,)). The slopes, the crest variable, the texture and the foam are
+        read only at the visible samples within the depressions ``window`` = (lo, hi) (nt,) that the
+        track's pixels see (:func:`visible_samples`: near grazing about half the samples are hidden, and
+        the sweep starts where the steepest ray might meet a crest of η_max, before the windows), 0
+        elsewhere; their per-point work in blocks (:func:`~roughsea_torch.renderer.hits.in_blocks`). The
+        quantiles x come as (the read samples' flat indices, sample-major (ns, nt), ascending; x at each),
+        for :func:`~roughsea_torch.renderer.hits.read_at`."""
         dtype = self.dtype
         ns, nt = sw.shape
         fpk = sw.footprint / self.hit_visibility  # (ns,) the node values' footprint F_s
-        fp = fpk[:, None].expand(ns, nt).reshape(1, -1)
         X, Y, t_s = sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1]
         # the samples read, sample-major (ns, nt)
-        sel = flat_nonzero(visible_samples(m.T, dim=0, window=(window[0][None, :], window[1][None, :])))
-        row = torch.div(sel, nt, rounding_mode="floor")
-        col = sel - row * nt
+        sel, row, col = nonzero_2d(visible_samples(m.T, dim=0, window=(window[0][None, :], window[1][None, :])))
         pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731  (faster than v[idx] on CPU)
-        Xv, Yv, fv = pick(X, sel)[None], pick(Y, sel)[None], pick(fp, sel)[None]
+        Xv, Yv, fv = pick(X, sel)[None], pick(Y, sel)[None], pick(fpk, row)[None]
         smp = wf.sample_unchecked(Xv, Yv, t_s, fv, elevation=False, crest=crest)
-        cov = wf.resolved_covariance(fpk[None])  # 3 of (1, ns)
-        cov_k = tuple(c[0] for c in cov)
+        cov_k = tuple(c[0] for c in wf.resolved_covariance(fpk[None]))  # 3 of (ns,)
         cx, sx = torch.cos(sw.az), torch.sin(sw.az)  # the tracks' ray directions (camera → sea)
-        x_v = resolved_quantile(smp["slope_x"][0], smp["slope_y"][0], tuple(pick(c, row) for c in cov_k), pick(cx, col),
-                                pick(sx, col))
         # each sample's row in the volume: ζ of its flat view zenith (the local vertical tilts by r/R)
         t0 = sw.flat_depression()
         cos_k = torch.sin(torch.atan(t0) + 2.0 * sw.curv * sw.r).clamp(1e-9, 1.0)
         zeta_k = torch.asinh(cos_k.double() / self.eps[im]).to(dtype)
-        gy = pick((2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez), row)
-        o = pick(coordinate(cx[None, None, :], sx[None, None, :], i), col)
-        read = self._read_volume(vol[i:i + 1], x_v[None, None], o[None, None], gy[None, None], a[i:i + 1],
-                                 b[i:i + 1])[0, :, 0]  # (C, P)
-        values = [read[0]]
-        if self.cross:  # + g y + h (y² − 1), y the across-view residual of the resolved slope over its rms
-            y = _across_quantile(smp["slope_x"][0], smp["slope_y"][0], tuple(pick(c, row) for c in cov_k),
-                                 pick(cx, col), pick(sx, col), x_v)
-            values = [read[0] + read[-2] * y + read[-1] * (y * y - 1.0)]
+        gy_k = (2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez)
+        o_t = coordinate(cx[None, None, :], sx[None, None, :], i)
+
+        def block(u: int, e: int) -> tuple:  # the texture and x at the read samples u:e
+            r_, c_, s_x, s_y = row[u:e], col[u:e], smp["slope_x"][0, u:e], smp["slope_y"][0, u:e]
+            cov_v, cx_v, sx_v = tuple(pick(c, r_) for c in cov_k), pick(cx, c_), pick(sx, c_)
+            x_v = resolved_quantile(s_x, s_y, cov_v, cx_v, sx_v)
+            read = self._read_volume(vol[i:i + 1], x_v[None, None], pick(o_t, c_)[None, None], pick(gy_k, r_)[None, None],
+                                     a[i:i + 1], b[i:i + 1])[0, :, 0]  # (C, e − u)
+            if not self.cross:
+                return read[0], x_v
+            # + g y + h (y² − 1), y the across-view residual of the resolved slope over its rms
+            y = _across_quantile(s_x, s_y, cov_v, cx_v, sx_v, x_v)
+            return read[0] + read[-2] * y + read[-1] * (y * y - 1.0), x_v
+
+        grad = torch.is_grad_enabled() and any(v.requires_grad for v in (vol, smp["slope_x"], cov_k[0], gy_k, o_t, a, b))
+        tex, x_v = in_blocks(block, sel.numel(), max(sel.numel(), 1) if grad else BLOCK)  # (whole with a graph)
+        values = [tex]
         if crest:
             var_r = pick(wf.crest_variance(fpk[None]), row)[None]
             f_act, f_res = whitecap_cover(wf, Xv, Yv, t_s, fv, smp["crest"], var_r, wf.crest_variance()[:, None],
                                           self.p.foam[im:im + 1].to(dtype)[:, None], trails=self.foam_trails)
             values += [f_act[0], f_res[0]]
-        # back to every sample (0 at the hidden ones), in the (nt, ns) layout of the envelope
-        full = x_v.new_zeros(len(values) + 1, nt * ns).index_copy(1, col * ns + row, torch.stack(values + [x_v]))
-        full = full.reshape(-1, nt, ns)
-        return full[:-1], full[-1], cov_k
+        # back to every sample (0 at the hidden ones), in the (nt, ns) layout of the envelope, row by row
+        full, at = x_v.new_zeros(len(values), nt * ns), (col * ns).add_(row)
+        for c, v in enumerate(values):
+            full[c].index_copy_(0, at, v)
+        return full.reshape(-1, nt, ns), (sel, x_v), cov_k
 
     def _row_statistics(self, sl: slice, wf: Any, gy: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor,
                         h: torch.Tensor, crest: bool) -> torch.Tensor:

@@ -6,13 +6,15 @@ from __future__ import annotations
 import math
 import warnings
 
+import numpy as np
 import pytest
 import torch
 
 import roughsea_torch as rs
 from roughsea_torch.raytrace import raytraced_image
-from roughsea_torch.renderer.hits import (Sweep, centre_element, covers, footprint_fade, pixel_hits, pixel_windows,
-                                          sample_step, sweep_envelope, visible_average, visible_samples)
+from roughsea_torch.renderer.hits import (Sweep, centre_element, covers, footprint_fade, in_blocks, nonzero_2d, pixel_hits,
+                                          pixel_windows, read_at, sample_step, sweep_envelope, visible_average,
+                                          visible_samples)
 
 F64 = torch.float64
 H_CAM = 10.0
@@ -54,12 +56,14 @@ def test_first_hit_is_the_crest_in_front_not_the_flat_point():
     assert bool((r[k[hidden]] < 100.0).all())  # met on the crest's front face
 
 
-def test_visible_average_weights_what_the_pixel_sees():
+@pytest.mark.parametrize("overwrite", [False, True])
+def test_visible_average_weights_what_the_pixel_sees(overwrite):
     """A quantity 1 on the crest's near face (from its foot to its top), 0 elsewhere: a pixel whose window
     spans the depressions about the crest's top sees the near face there, not the trough hidden behind
     it, so its average is the near face's share of its window, computed by brute force over a fine fan
     of rays (2,000 per window); a window of steep rays, entirely on the flat sea before the crest, sees
-    0; a quantity 1 everywhere averages to 1 where the sweep covers the window."""
+    0; a quantity 1 everywhere averages to 1 where the sweep covers the window. ``overwrite``: the same
+    through :func:`pixel_hits` letting the cumulative sums take the values' buffer."""
     r = torch.linspace(20.0, 400.0, 7601, dtype=F64)
     eta = _bump(r)
     sw = _sweep(r)
@@ -70,7 +74,10 @@ def test_visible_average_weights_what_the_pixel_sees():
     t_top = torch.tensor([0.06, 0.075, 0.2], dtype=F64)
     t_bot = torch.tensor([0.09, 0.085, 0.3], dtype=F64)
     j = torch.zeros(3, dtype=torch.long)
-    avg = visible_average(m, values, j, t_top, t_bot)
+    if overwrite:
+        avg = pixel_hits(m, values.clone(), j, t_top, t_bot, 0.5 * (t_top + t_bot), overwrite=True)[0]
+    else:
+        avg = visible_average(m, values, j, t_top, t_bot)
     fan = lambda a, b: torch.linspace(a, b, 2001, dtype=F64)[1:-1]  # noqa: E731
     dense = torch.linspace(20.0, 400.0, 76001, dtype=F64)
     dense_eta = _bump(dense)
@@ -79,6 +86,45 @@ def test_visible_average_weights_what_the_pixel_sees():
         assert abs(float(avg[0, i]) - float(((hits <= top) & (hits >= top - 12.0)).to(F64).mean())) < 0.02
         assert abs(float(avg[1, i]) - 1.0) < 1e-9
     assert float(avg[0, 2]) < 1e-9  # steep rays land before the crest
+
+
+def test_read_at_is_the_dense_array_read_at_those_indices():
+    """:func:`read_at` gives what numpy's dense array (the values at their indices, 0 elsewhere) gives at
+    any flat positions, present or not, in the shape of the positions; 0 from an empty index."""
+    rng = np.random.default_rng(3)
+    n = 500
+    index = np.sort(rng.choice(n, 180, replace=False))
+    values = rng.normal(size=180)
+    dense = np.zeros(n)
+    dense[index] = values
+    at = rng.integers(0, n, size=(7, 40))
+    got = read_at(torch.from_numpy(index), torch.from_numpy(values), torch.from_numpy(at))
+    assert got.shape == (7, 40) and np.array_equal(got.numpy(), dense[at])
+    assert not np.isin(at, index).all()  # (some positions are absent)
+    empty = read_at(torch.zeros(0, dtype=torch.long), torch.zeros(0, dtype=F64), torch.from_numpy(at))
+    assert empty.shape == (7, 40) and not empty.any()
+
+
+def test_nonzero_2d_is_numpys_nonzero_in_row_major_order():
+    """:func:`nonzero_2d` gives numpy's ``nonzero`` of a 2-D mask (rows, columns) and their flat indices
+    row · W + col, in row-major order; empty for a mask without a True element."""
+    mask = np.random.default_rng(5).random((37, 23)) < 0.3
+    flat, row, col = nonzero_2d(torch.from_numpy(mask))
+    r, c = np.nonzero(mask)
+    assert np.array_equal(row.numpy(), r) and np.array_equal(col.numpy(), c)
+    assert np.array_equal(flat.numpy(), r * 23 + c) and flat.dtype == row.dtype == col.dtype == torch.int64
+    assert all(t.numel() == 0 for t in nonzero_2d(torch.zeros(4, 5, dtype=torch.bool)))
+
+
+def test_in_blocks_joins_a_pointwise_function_over_all_points():
+    """:func:`in_blocks` of a pointwise function (two outputs, the second with a leading axis) over 2.5
+    blocks equals numpy's whole-array result; one call on no point gives empty outputs."""
+    x = np.random.default_rng(7).normal(size=45)
+    xt = torch.from_numpy(x)
+    a, b = in_blocks(lambda u, e: (xt[u:e] * 3.0 + 1.0, torch.stack([xt[u:e], xt[u:e] * xt[u:e]])), 45, 18)
+    assert np.array_equal(a.numpy(), x * 3.0 + 1.0) and np.array_equal(b.numpy(), np.stack([x, x * x]))
+    (e,) = in_blocks(lambda u, e: (xt[u:e],), 0, 18)
+    assert e.numel() == 0
 
 
 def _render(hit: str, sky=None, **kw):
