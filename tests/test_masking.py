@@ -76,24 +76,28 @@ def test_facets_turned_towards_the_sensor_are_masked_less():
 # ------------------------------------------------------------------------------------------------
 # 2. Physics of the option, every backend
 # ------------------------------------------------------------------------------------------------
-@pytest.mark.parametrize("th_deg", [75.0, 88.0])
-def test_second_law_with_correlated_masking(backend, th_deg):
-    """R_s ≡ R_B ⇒ R_a = R_B whatever the facet weight."""
+@pytest.mark.parametrize("option", ["correlated", "multiscale"])
+@pytest.mark.parametrize("th_deg", [75.0, 88.0, 90.0])
+def test_second_law_with_masking_options(backend, th_deg, option):
+    """R_s ≡ R_B ⇒ R_a = R_B whatever the facet weight (both masking options; the multi-scale one's
+    tests are in tests/test_multiscale_masking.py)."""
     slopes = backend.slopes(0.2, 0.12, 0.3)
-    ra = backend.apparent_radiance(th_deg * DEG, 0.4, slopes, M11, 27.5, 27.5, shadowing="correlated")
+    ra = backend.apparent_radiance(th_deg * DEG, 0.4, slopes, M11, 27.5, 27.5, shadowing=option)
     np.testing.assert_allclose(ra, 27.5, rtol=max(backend.rtol, 1e-7) * 0.1)
 
 
+@pytest.mark.parametrize("option", ["correlated", "multiscale"])
 @pytest.mark.parametrize("th_deg, sigma", [(60.0, 0.02), (5.0, 0.2)])
-def test_equals_eq5_where_masking_vanishes(backend, th_deg, sigma):
-    """Small slopes or a near-vertical view: ν = cot θ̂ / σ∥ ≥ 8, no facet is masked, Eq. 5 is recovered."""
+def test_equals_eq5_where_masking_vanishes(backend, th_deg, sigma, option):
+    """Small slopes or a near-vertical view: ν = cot θ̂ / σ∥ ≥ 8, no facet is masked (the multi-scale
+    factor 1 − e^{−2ν(x+ν)} is 1 wherever the Gaussian has weight), Eq. 5 is recovered."""
     slopes = backend.slopes(sigma, 0.8 * sigma, 0.1)
     th = th_deg * DEG
     e5 = backend.emissivity(th, 0.3, slopes, M11, shadowing=True)
-    ec = backend.emissivity(th, 0.3, slopes, M11, shadowing="correlated")
+    ec = backend.emissivity(th, 0.3, slopes, M11, shadowing=option)
     np.testing.assert_allclose(ec, e5, rtol=max(backend.rtol, 1e-7))
     r5 = backend.apparent_radiance(th, 0.3, slopes, M11, 30.0, smooth_sky, shadowing=True)
-    rc = backend.apparent_radiance(th, 0.3, slopes, M11, 30.0, smooth_sky, shadowing="correlated")
+    rc = backend.apparent_radiance(th, 0.3, slopes, M11, 30.0, smooth_sky, shadowing=option)
     np.testing.assert_allclose(rc, r5, rtol=max(backend.rtol, 1e-7))
 
 
@@ -161,15 +165,16 @@ def test_values_and_gradients_finite_at_extremes(dtype, case):
         assert bool(torch.isfinite(g).all())
 
 
-def test_batched_equals_looped():
+@pytest.mark.parametrize("option", ["correlated", "multiscale"])
+def test_batched_equals_looped(option):
     th = torch.tensor([70.0, 85.0, 88.0], dtype=F64) * DEG
     w = torch.tensor([4.0, 9.0, 15.0], dtype=F64)
     s = rs.SlopeStatistics.cox_munk(w, anisotropic=True)
-    batch = rs.apparent_radiance(th[:, None], 0.5, s, M11, sea_radiance=30.0, sky=smooth_sky, shadowing="correlated")
+    batch = rs.apparent_radiance(th[:, None], 0.5, s, M11, sea_radiance=30.0, sky=smooth_sky, shadowing=option)
     for i in range(3):
         for j in range(3):
             one = rs.apparent_radiance(th[i], 0.5, rs.SlopeStatistics.cox_munk(w[j], anisotropic=True), M11,
-                                       sea_radiance=30.0, sky=smooth_sky, shadowing="correlated")
+                                       sea_radiance=30.0, sky=smooth_sky, shadowing=option)
             torch.testing.assert_close(batch[i, j], one, rtol=1e-12, atol=0)
 
 

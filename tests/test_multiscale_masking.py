@@ -4,14 +4,14 @@
    of the longer ones), computed here in plain numpy as a Markov chain on the along-view slope,
    converges to the closed-form density the package's factor Q gives; its normalization is the mean
    plane's projected area, cos θ̂ + sin θ̂ m∥, exactly.
-2. Physics of the option, asserted of every backend (reference, torch64, torch32): the second law;
-   Eq. 5 recovered where masking vanishes; near grazing the facets seen face the sensor more than
-   Eq. 5's, so the emissivity rises, more than with the correlated masking.
+2. Physics of the option, asserted of every backend (reference, torch64, torch32): near grazing the facets
+   seen face the sensor more than Eq. 5's, so the emissivity rises, more than with the correlated masking
+   (the second law, Eq. 5 where masking vanishes and batching are tests/test_masking.py's, for both options).
 3. The torch option against the numpy reference (emissivity and Eq. 10, zero and shifted means, at
    the horizon, and a tilt that turns the mean plane away: the continuation below the ν floor).
 4. Guarantees of the torch code: finite values and gradients at the extremes (grazing, horizon, calm
    sea, steep anisotropy, a resolved tilt turning the mean plane away), continuity through the
-   horizon's limit, batching, a ValueError naming ``shadowing``.
+   horizon's limit, a ValueError naming ``shadowing``.
 (Against the brute-force ray tracer: tests/test_raytrace.py and tests/renderer/test_hits.py.)
 """
 
@@ -95,27 +95,6 @@ def test_normalization_is_the_mean_planes_projected_area(dtype, rtol, th_deg, ph
 # ------------------------------------------------------------------------------------------------
 # 2. Physics of the option, every backend
 # ------------------------------------------------------------------------------------------------
-@pytest.mark.parametrize("th_deg", [75.0, 88.0, 90.0])
-def test_second_law_with_multiscale_masking(backend, th_deg):
-    """R_s ≡ R_B ⇒ R_a = R_B whatever the facet weight."""
-    slopes = backend.slopes(0.2, 0.12, 0.3)
-    ra = backend.apparent_radiance(th_deg * DEG, 0.4, slopes, M11, 27.5, 27.5, shadowing="multiscale")
-    np.testing.assert_allclose(ra, 27.5, rtol=max(backend.rtol, 1e-7) * 0.1)
-
-
-@pytest.mark.parametrize("th_deg, sigma", [(60.0, 0.02), (5.0, 0.2)])
-def test_equals_eq5_where_masking_vanishes(backend, th_deg, sigma):
-    """ν = cot θ̂ / σ∥ ≥ 8: Q = 1 − e^{−2ν(x+ν)} is 1 wherever the Gaussian has weight: Eq. 5."""
-    slopes = backend.slopes(sigma, 0.8 * sigma, 0.1)
-    th = th_deg * DEG
-    e5 = backend.emissivity(th, 0.3, slopes, M11, shadowing=True)
-    em = backend.emissivity(th, 0.3, slopes, M11, shadowing="multiscale")
-    np.testing.assert_allclose(em, e5, rtol=max(backend.rtol, 1e-7))
-    r5 = backend.apparent_radiance(th, 0.3, slopes, M11, 30.0, smooth_sky, shadowing=True)
-    rm = backend.apparent_radiance(th, 0.3, slopes, M11, 30.0, smooth_sky, shadowing="multiscale")
-    np.testing.assert_allclose(rm, r5, rtol=max(backend.rtol, 1e-7))
-
-
 def test_seen_facets_face_the_sensor_more_near_grazing(backend):
     """Near grazing the short waves on the back of a long one are hidden: the facets seen are tilted
     towards the sensor, seen at larger cos Ω, so the emissivity rises above Eq. 5's (0.60 → 0.67 at 88°,
@@ -202,18 +181,6 @@ def test_continuous_through_the_horizon_limit():
     horizon = [float(rs.apparent_radiance(torch.tensor(t, dtype=F64), 0.3, s0, M11, sea_radiance=30.0, sky=smooth_sky,
                                           shadowing="multiscale")) for t in (math.pi / 2 - 1e-5, math.pi / 2)]
     assert abs(horizon[0] - horizon[1]) < 1e-4 * 30.0 and abs(horizon[1] - 30.0) > 0.1, horizon
-
-
-def test_batched_equals_looped():
-    th = torch.tensor([70.0, 85.0, 88.0], dtype=F64) * DEG
-    w = torch.tensor([4.0, 9.0, 15.0], dtype=F64)
-    s = rs.SlopeStatistics.cox_munk(w, anisotropic=True)
-    batch = rs.apparent_radiance(th[:, None], 0.5, s, M11, sea_radiance=30.0, sky=smooth_sky, shadowing="multiscale")
-    for i in range(3):
-        for j in range(3):
-            one = rs.apparent_radiance(th[i], 0.5, rs.SlopeStatistics.cox_munk(w[j], anisotropic=True), M11,
-                                       sea_radiance=30.0, sky=smooth_sky, shadowing="multiscale")
-            torch.testing.assert_close(batch[i, j], one, rtol=1e-12, atol=0)
 
 
 @pytest.mark.parametrize("bad", ["multi-scale", "Multiscale", "smith"])
