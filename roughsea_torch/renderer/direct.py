@@ -30,7 +30,7 @@ from .path import apply_path, check_path_altitude
 from .scene import SceneParameters, SeaScene
 from .settings import TableSize
 from .sky_terms import day_sky, day_sky_pixels, relative_sun, sky_rows, sky_with_day, sun_disk_pixels
-from .texture import single_quantile
+from .texture import single_quantile, warn_eq7
 
 __all__ = ["render_direct", "sea_direct", "sea_textured_direct"]
 
@@ -126,6 +126,10 @@ def sea_textured_direct(geom: ViewGeometry, cameras: PinholeCamera, p: ScenePara
     th, ph = geom.view_zenith[sea], relative_azimuth(geom, p)[sea]
     vx, vy, cxy = p.vx[img_idx], p.vy[img_idx], p.cxy[img_idx]
     slopes = single_quantile(two_scale_statistics(vx, vy, cxy, ph, torch.cos(th), x[sea][:, None], var_a[sea], kap[sea]))
+    if scene.shadowing is False:  # Eq. 7 divides by the mean facet's projected area e (as TextureTable._check_eq7)
+        e = torch.cos(th) + torch.sin(th) * (slopes.mean_upwind * torch.cos(ph) + slopes.mean_crosswind * torch.sin(ph))
+        if bool((e <= 0).any()):
+            warn_eq7()
     sky = select_sky(p.sky, img_idx.cpu())
     day = day_sky(scene, B, dtype, device)
     if day is not None:  # the sky each pixel reflects, along its mirror azimuth

@@ -589,8 +589,8 @@ def warn_eq7() -> None:
     (:meth:`TextureTable._check_eq7`), pointing at the user's line (as :func:`warn_scaled`)."""
     warnings.warn("SeaScene(shadowing=False, seed=...): near grazing the resolved waves tilt some pixels' mean facet "
                   "away from the sensor, where Eq. 7 divides by a projected area that vanishes or is negative: "
-                  "the texture there is meaningless (radiances far out of range). Use shadowing=True (Eq. 5) or "
-                  "'correlated' for textured seas seen near grazing.", stacklevel=_user_level())
+                  "the texture there is meaningless (radiances far out of range). Use shadowing=True (Eq. 5), "
+                  "'correlated' or 'multiscale' for textured seas seen near grazing.", stacklevel=_user_level())
 
 
 def _user_level() -> int:
