@@ -55,6 +55,8 @@ import texture_vs_raytrace as tvr  # noqa: E402
 
 import roughsea_torch as rs  # noqa: E402
 from roughsea_torch import raytrace as rt  # noqa: E402
+from roughsea_torch.atmosphere import load_sky  # noqa: E402
+from roughsea_torch.multiscale_masking import multiscale_ratio  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
 PITCH = -6.0
@@ -107,7 +109,7 @@ def sweep(bar_desc: str = "k_max sweep") -> list[dict]:
     band = rs.LWIR
     m = rs.band_refractive_index(band, tvr.T_SEA).to(torch.complex128)
     rb = rs.band_radiance(torch.tensor(tvr.T_SEA, dtype=torch.float64), band)
-    sky = rt._sky_callable("midlatitude_summer", band, torch.float64, torch.device("cpu"))
+    sky = load_sky("midlatitude_summer", band, dtype=torch.float64)
     c, s = math.cos(los), math.sin(los)
     out = []
     for k_max in tqdm((1.0, 4.0, 16.0, 64.0), desc=bar_desc):
@@ -136,7 +138,7 @@ def lever() -> list[dict]:
     band, dt = rs.LWIR, torch.float64
     m = rs.band_refractive_index(band, tvr.T_SEA).to(torch.complex128)
     rb = rs.band_radiance(torch.tensor(tvr.T_SEA, dtype=dt), band)
-    sky = rt._sky_callable("midlatitude_summer", band, dt, torch.device("cpu"))
+    sky = load_sky("midlatitude_summer", band, dtype=dt)
     rows = []
     for th_deg in (82.0, 86.0, 88.0):
         for sig in (0.061, 0.1):
@@ -155,11 +157,12 @@ def lever() -> list[dict]:
 def cascade_radiance(th: float, los: float, var_par: float, var_acr: float, rest, m, rb, sky, n: int = 600) -> float:
     """R_a [W m⁻² sr⁻¹] of the multi-scale cascade over slopes of along/across-view variances (var_par,
     var_acr) with Eq. 5 for ``rest`` (SlopeStatistics) about each: the seen along-view slope s of the cascaded
-    part has the density (h/h₀)[φ_V(h − h₀) − φ_V(h + h₀)], h = cot θ̂ + s, h₀ = cot θ̂, V = var_par
-    (:mod:`roughsea_torch.multiscale_masking`), its across-view slope N(0, var_acr) (12 Gauss–Hermite nodes)."""
-    h0 = 1.0 / math.tan(th)
-    h = torch.linspace(1e-9, h0 + 9.0 * math.sqrt(var_par), n, dtype=torch.float64)
-    dens = h / h0 * (torch.exp(-(h - h0) ** 2 / (2 * var_par)) - torch.exp(-(h + h0) ** 2 / (2 * var_par)))
+    part has the density ∝ h φ_V(h − h₀) Q (= (h/h₀)[φ_V(h − h₀) − φ_V(h + h₀)]), h = cot θ̂ + s, h₀ = cot θ̂,
+    V = var_par, Q the package's factor (:func:`~roughsea_torch.multiscale_masking.multiscale_ratio`), its
+    across-view slope N(0, var_acr) (12 Gauss–Hermite nodes)."""
+    h0, sd = 1.0 / math.tan(th), math.sqrt(var_par)
+    h = torch.linspace(1e-9, h0 + 9.0 * sd, n, dtype=torch.float64)
+    dens = h * torch.exp(-(h - h0) ** 2 / (2 * var_par)) * multiscale_ratio((h - h0) / sd, torch.tensor(h0 / sd))
     xg, wg = np.polynomial.hermite_e.hermegauss(12)
     xg, wg = torch.as_tensor(xg), torch.as_tensor(wg / wg.sum())
     par = (h - h0)[:, None].expand(-1, 12)

@@ -40,7 +40,7 @@ from typing import Any, Callable, Sequence, TypeVar
 
 import torch
 
-__all__ = ["map_chunks", "one_thread"]
+__all__ = ["map_chunks", "one_thread", "BLOCK", "in_blocks"]
 
 T = TypeVar("T")
 _local = threading.local()
@@ -106,3 +106,14 @@ def one_thread(fn: Callable[[], T], device: torch.device | str | None) -> T:
     finally:
         torch.set_num_threads(n)
 
+
+BLOCK = 1 << 15  # points per block of per-point work (:func:`in_blocks`)
+
+
+def in_blocks(fn: Callable[[int, int], tuple], n: int, block: int = BLOCK) -> tuple:
+    """``fn(u, e)`` on the blocks [u, e) of ``n`` points, ``block`` at a time, its outputs (tensors whose last
+    axis runs over the block's points) joined along that axis: per-point work done a block at a time keeps
+    its temporaries in cache (serially, on the calling thread). The same values as one call on all the
+    points when ``fn`` is pointwise; ``n`` = 0 calls ``fn(0, 0)`` once."""
+    parts = [fn(u, min(n, u + block)) for u in range(0, max(n, 1), block)]
+    return tuple(p[0] if len(p) == 1 else torch.cat(p, -1) for p in zip(*parts))

@@ -28,6 +28,7 @@ from typing import Sequence
 
 import torch
 
+from ._parallel import BLOCK, in_blocks
 from .counter_hash import bits_uniform, splitmix64
 
 __all__ = ["STREAK_LENGTH_M", "STREAK_ANISOTROPY", "streak_lengths", "streak_noise", "cell_bound", "resolved_amplitude",
@@ -94,7 +95,7 @@ def streak_noise(x: torch.Tensor, y: torch.Tensor, seeds: Sequence[int], cos_win
     """
     base = splitmix64(torch.tensor([int(sd) for sd in seeds], dtype=torch.int64, device=x.device) * 0x5DEECE66D + 17)
     # image by image (image i of a batch is then bitwise the image rendered alone), and within an image block
-    # by block of _BLOCK points, so that the per-point temporaries stay in cache
+    # by block of points (_parallel.in_blocks), so that the per-point temporaries stay in cache
     out = []
     for i in range(x.shape[0]):
         xd, yd = x[i].to(torch.float64), y[i].to(torch.float64)
@@ -106,14 +107,14 @@ def streak_noise(x: torch.Tensor, y: torch.Tensor, seeds: Sequence[int], cos_win
         xd, yd = xd.reshape(-1), yd.reshape(-1)
         lim = None if lim is None else lim.reshape(-1)
         frame = tuple(t[i].to(torch.float64) for t in (cos_wind, sin_wind, length_along, length_across))
-        parts = [_block_noise(base[i], xd[a:a + _BLOCK], yd[a:a + _BLOCK], frame,
-                              None if lim is None else lim[a:a + _BLOCK]) for a in range(0, xd.shape[0], _BLOCK)]
-        nu = (torch.cat(parts) if parts else xd).reshape(shape).to(x.dtype)
+        (nu,) = in_blocks(lambda u, e: (_block_noise(base[i], xd[u:e], yd[u:e], frame, None if lim is None else lim[u:e]),),
+                          xd.shape[0], _BLOCK)
+        nu = nu.reshape(shape).to(x.dtype)
         out.append(nu if where is None else torch.zeros_like(x[i]).index_put((where[i],), nu))
     return torch.stack(out)
 
 
-_BLOCK = 1 << 15  # points per block of streak_noise's per-point work
+_BLOCK = BLOCK  # points per block of streak_noise's per-point work (a module constant the tests vary)
 _CORNERS = ((0, 0), (0, 1), (1, 0), (1, 1))
 
 

@@ -81,6 +81,6 @@ def multiscale_ratio(x: torch.Tensor, nu: torch.Tensor) -> torch.Tensor:
         Q in [0, 1), x's dtype and device; differentiable (its gradient is finite everywhere: Q is
         continuous at the visibility edge x = −ν, where it is 0)."""
     on = (x + nu) > 0
-    nf = nu.clamp_min(NU_FLOOR) if isinstance(nu, torch.Tensor) else max(float(nu), NU_FLOOR)
+    nf = nu.clamp_min(NU_FLOOR)
     z = torch.where(on, -2.0 * nf * (x + nf), torch.zeros_like(x))
     return torch.where(on, -torch.expm1(z), torch.zeros_like(z))

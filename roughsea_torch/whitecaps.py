@@ -102,6 +102,7 @@ from typing import Any
 
 import torch
 
+from ._parallel import BLOCK, in_blocks
 from ._validation import check_finite_range
 from .foam import crest_fraction_from_variances, foam_radiance, vanishing_crest
 from .foam_streaks import resolved_amplitude, streak_lengths, streak_noise
@@ -322,7 +323,9 @@ def whitecap_cover(wf: Any, x: torch.Tensor, y: torch.Tensor, time_s: torch.Tens
     return a * now, (1.0 - a) * torch.lerp(now, residual, share)
 
 
-_COVER_BLOCK = 2**15  # point-evaluations per block of _cover_now (its temporaries stay in cache)
+
+
+_COVER_BLOCK = BLOCK  # point-evaluations per block of _cover_now (a module constant the tests vary)
 
 
 def _cover_now(noise: Any, x: torch.Tensor, y: torch.Tensor, crest: torch.Tensor, keep: torch.Tensor | None,
@@ -344,13 +347,15 @@ def _cover_now(noise: Any, x: torch.Tensor, y: torch.Tensor, crest: torch.Tensor
 
     xs, ys, cs, ks, ps, vr, vt, ws = (flat(t) for t in (x, y, crest, keep, per_nu, v_res, v_tot, w))
     npts = xs.shape[1]
-    step = max(1024, _COVER_BLOCK // max(b, 1))
-    out = []
-    for a in range(0, npts, step):
-        xb, yb, cb, kb, pb, vrb, vtb, wb = (t[:, a:a + step] if isinstance(t, torch.Tensor) and t.ndim == 2
+    if npts == 0:
+        return x.new_zeros(shape)
+
+    def block(u: int, e: int) -> tuple:
+        xb, yb, cb, kb, pb, vrb, vtb, wb = (t[:, u:e] if isinstance(t, torch.Tensor) and t.ndim == 2
                                             and t.shape[1] > 1 else t for t in (xs, ys, cs, ks, ps, vr, vt, ws))
         x0 = vanishing_crest(vrb, vtb, wb, x.dtype)
         below = ((x0 - cb.detach().double()) / torch.as_tensor(pb).detach().double()).expand(xb.shape)
         lift = pb * noise(xb, yb, kb, below)
-        out.append(crest_fraction_from_variances(cb + lift, vrb, vtb, wb))
-    return (torch.cat(out, 1) if out else x.new_zeros(b, 0)).reshape(shape)
+        return (crest_fraction_from_variances(cb + lift, vrb, vtb, wb),)
+
+    return in_blocks(block, npts, max(1024, _COVER_BLOCK // max(b, 1)))[0].reshape(shape)

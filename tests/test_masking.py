@@ -113,27 +113,42 @@ def test_seen_facets_steeper_near_grazing(backend):
 # ------------------------------------------------------------------------------------------------
 # 3. Torch against the reference
 # ------------------------------------------------------------------------------------------------
-REF_CASES = ((85.0, 0.3, (0.15, 0.12, 0.1)), (88.0, 0.0, (0.2, 0.16, 0.0)))
+ZERO = (0.0, 0.0)
+REF_CASES = {  # (view zenith [deg], φ̂, (a, b, r), mean slope); the correlated reference takes zero means only
+    "correlated": ((85.0, 0.3, (0.15, 0.12, 0.1), ZERO), (88.0, 0.0, (0.2, 0.16, 0.0), ZERO)),
+    "multiscale": ((85.0, 0.3, (0.15, 0.12, 0.1), ZERO), (88.0, 0.0, (0.2, 0.16, 0.0), ZERO),
+                   (87.0, 1.0, (0.1, 0.12, 0.0), (0.03, -0.05)), (86.0, 0.2, (0.1, 0.08, 0.2), (-0.06, 0.01)),
+                   (90.0, 0.5, (0.12, 0.1, 0.0), ZERO),
+                   (87.0, 0.0, (0.1, 0.1, 0.0), (-0.1, 0.0))),  # the last: a tilt turning the mean plane away, ν = −0.48
+}
+RTOL = {"correlated": {torch.float64: 2e-5, torch.float32: 4e-5},  # (the correlated table's interpolation)
+        "multiscale": {torch.float64: 2e-6, torch.float32: 4e-5}}
 
 
-@pytest.fixture(scope="module")
-def reference_correlated():
-    """(ε̄, R_a) of the numpy reference with shadowing="correlated" for REF_CASES (computed once)."""
-    out = []
-    for th_deg, ph, (a, b, r) in REF_CASES:
+@pytest.fixture(scope="module", params=list(REF_CASES))
+def reference_values(request):
+    """(option, [(ε̄, R_a)]) of the numpy reference for that option's REF_CASES (computed once)."""
+    option, out = request.param, []
+    for th_deg, ph, (a, b, r), mean in REF_CASES[option]:
         s = ref.SlopeStatistics(a, b, r)
-        out.append((float(ref.emissivity(th_deg * DEG, ph, s, M11, shadowing="correlated")),
-                    float(ref.apparent_radiance(th_deg * DEG, ph, s, M11, 30.0, smooth_sky, shadowing="correlated"))))
-    return out
+        kw = dict(shadowing=option, slope_mean=mean)
+        out.append((float(ref.emissivity(th_deg * DEG, ph, s, M11, **kw)),
+                    float(ref.apparent_radiance(th_deg * DEG, ph, s, M11, 30.0, smooth_sky, **kw))))
+    return option, out
 
 
-@pytest.mark.parametrize("dtype, rtol", [(torch.float64, 2e-5), (torch.float32, 4e-5)])
-def test_correlated_matches_reference(reference_correlated, dtype, rtol):
-    for (th_deg, ph, (a, b, r)), (e_ref, r_ref) in zip(REF_CASES, reference_correlated):
+@pytest.mark.parametrize("dtype", [torch.float64, torch.float32])
+def test_masking_options_match_reference(reference_values, dtype):
+    """Both masked options against the numpy reference (the multi-scale one with shifted means too)."""
+    option, values = reference_values
+    rtol = RTOL[option][dtype]
+    for (th_deg, ph, (a, b, r), mean), (e_ref, r_ref) in zip(REF_CASES[option], values):
         s = rs.SlopeStatistics(*(torch.tensor(v, dtype=dtype) for v in (a, b, r)))
+        if mean != ZERO:
+            s = s.shifted(*mean)
         t = torch.tensor(th_deg * DEG, dtype=dtype)
-        e = float(rs.emissivity(t, ph, s, M11, shadowing="correlated"))
-        ra = float(rs.apparent_radiance(t, ph, s, M11, sea_radiance=30.0, sky=smooth_sky, shadowing="correlated"))
+        e = float(rs.emissivity(t, ph, s, M11, shadowing=option))
+        ra = float(rs.apparent_radiance(t, ph, s, M11, sea_radiance=30.0, sky=smooth_sky, shadowing=option))
         assert abs(e / e_ref - 1.0) < rtol, (th_deg, e, e_ref)
         assert abs(ra / r_ref - 1.0) < rtol, (th_deg, ra, r_ref)
 

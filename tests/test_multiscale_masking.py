@@ -107,40 +107,6 @@ def test_seen_facets_face_the_sensor_more_near_grazing(backend):
 
 
 # ------------------------------------------------------------------------------------------------
-# 3. Torch against the reference
-# ------------------------------------------------------------------------------------------------
-REF_CASES = ((85.0, 0.3, (0.15, 0.12, 0.1), (0.0, 0.0)), (88.0, 0.0, (0.2, 0.16, 0.0), (0.0, 0.0)),
-             (87.0, 1.0, (0.1, 0.12, 0.0), (0.03, -0.05)), (86.0, 0.2, (0.1, 0.08, 0.2), (-0.06, 0.01)),
-             (90.0, 0.5, (0.12, 0.1, 0.0), (0.0, 0.0)),
-             (87.0, 0.0, (0.1, 0.1, 0.0), (-0.1, 0.0)))  # the last: a tilt turning the mean plane away, ν = −0.48
-
-
-@pytest.fixture(scope="module")
-def reference_multiscale():
-    """(ε̄, R_a) of the numpy reference with shadowing="multiscale" for REF_CASES (computed once)."""
-    out = []
-    for th_deg, ph, (a, b, r), mean in REF_CASES:
-        s = ref.SlopeStatistics(a, b, r)
-        out.append((float(ref.emissivity(th_deg * DEG, ph, s, M11, shadowing="multiscale", slope_mean=mean)),
-                    float(ref.apparent_radiance(th_deg * DEG, ph, s, M11, 30.0, smooth_sky, shadowing="multiscale",
-                                                slope_mean=mean))))
-    return out
-
-
-@pytest.mark.parametrize("dtype, rtol", [(torch.float64, 2e-6), (torch.float32, 4e-5)])
-def test_multiscale_matches_reference(reference_multiscale, dtype, rtol):
-    for (th_deg, ph, (a, b, r), mean), (e_ref, r_ref) in zip(REF_CASES, reference_multiscale):
-        s = rs.SlopeStatistics(*(torch.tensor(v, dtype=dtype) for v in (a, b, r)))
-        if mean != (0.0, 0.0):
-            s = s.shifted(*mean)
-        t = torch.tensor(th_deg * DEG, dtype=dtype)
-        e = float(rs.emissivity(t, ph, s, M11, shadowing="multiscale"))
-        ra = float(rs.apparent_radiance(t, ph, s, M11, sea_radiance=30.0, sky=smooth_sky, shadowing="multiscale"))
-        assert abs(e / e_ref - 1.0) < rtol, (th_deg, e, e_ref)
-        assert abs(ra / r_ref - 1.0) < rtol, (th_deg, ra, r_ref)
-
-
-# ------------------------------------------------------------------------------------------------
 # 4. Guarantees of the torch code
 # ------------------------------------------------------------------------------------------------
 EXTREMES = {

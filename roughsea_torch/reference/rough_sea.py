@@ -130,13 +130,14 @@ def masking_weight(shadowing, th, ph, a, b, r, mean=(0.0, 0.0)):
         return None
     cot = math.cos(th) / max(math.sin(th), 1e-300)
     if shadowing == "multiscale":
-        h0 = max(cot + mean[0] * c + mean[1] * s, 1e-6 * sig)
+        h_mean = cot + mean[0] * c + mean[1] * s
+        h0 = max(h_mean, 1e-6 * sig)
 
         def q(s_par):
             h = cot + s_par
             if h <= 0.0:
                 return 0.0
-            return -math.expm1(-2.0 * (h - (cot + mean[0] * c + mean[1] * s) + h0) * h0 / (sig * sig))
+            return -math.expm1(-2.0 * (h - h_mean + h0) * h0 / (sig * sig))
 
         return q
     if is_shifted(mean):

@@ -68,7 +68,7 @@ from ..clutter import footprint
 from ..wave_bands import band_window
 
 __all__ = ["Sweep", "sweep_layout", "sweep_envelope", "running_minimum", "track_windows", "covers", "visible_samples",
-           "flat_nonzero", "nonzero_2d", "BLOCK", "in_blocks", "read_at", "pixel_windows", "visible_average",
+           "flat_nonzero", "nonzero_2d", "read_at", "pixel_windows", "visible_average",
            "centre_element", "pixel_hits", "sample_step", "footprint_fade"]
 
 
@@ -263,17 +263,6 @@ def flat_nonzero(mask: torch.Tensor) -> torch.Tensor:
     if flat.device.type == "cpu":
         return torch.from_numpy(np.flatnonzero(flat.numpy())).to(torch.int64)
     return flat.nonzero().squeeze(1)
-
-
-BLOCK = 1 << 15  # points per block of per-point work (:func:`in_blocks`)
-
-
-def in_blocks(fn: Any, n: int, block: int = BLOCK) -> tuple:
-    """``fn(u, e)`` on the blocks [u, e) of ``n`` points, ``block`` at a time, its outputs (tensors whose last
-    axis runs over the block's points) joined along that axis: per-point work done a block at a time keeps
-    its temporaries in cache. The same values as one call on all the points when ``fn`` is pointwise."""
-    parts = [fn(u, min(n, u + block)) for u in range(0, max(n, 1), block)]
-    return tuple(p[0] if len(p) == 1 else torch.cat(p, -1) for p in zip(*parts))
 
 
 def read_at(index: torch.Tensor, values: torch.Tensor, at: torch.Tensor) -> torch.Tensor:

@@ -20,6 +20,7 @@ from typing import Any
 import torch
 import torch.nn.functional as F
 
+from .._parallel import BLOCK, in_blocks
 from .._validation import per_batch
 from ..clutter import along_view, footprint, reconcile_scale, resolved_quantile, two_scale_statistics, view_moments
 from ..expectation import reflection_terms
@@ -28,7 +29,7 @@ from ..sky import ConstantSky, TabulatedSky, select_sky
 from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
-from .hits import (BLOCK, Sweep, covers, flat_nonzero, footprint_fade, in_blocks, nonzero_2d, pixel_hits, pixel_windows,
+from .hits import (Sweep, covers, flat_nonzero, footprint_fade, nonzero_2d, pixel_hits, pixel_windows,
                    read_at, sample_step, sweep_envelope, sweep_layout, track_windows, visible_samples)
 from .path import path_rows
 from .scene import SceneParameters
@@ -458,7 +459,7 @@ class TextureTable:
         read only at the visible samples within the depressions ``window`` = (lo, hi) (nt,) that the
         track's pixels see (:func:`visible_samples`: near grazing about half the samples are hidden, and
         the sweep starts where the steepest ray might meet a crest of η_max, before the windows), 0
-        elsewhere; their per-point work in blocks (:func:`~roughsea_torch.renderer.hits.in_blocks`). The
+        elsewhere; their per-point work in blocks (:func:`~roughsea_torch._parallel.in_blocks`). The
         quantiles x come as (the read samples' flat indices, sample-major (ns, nt), ascending; x at each),
         for :func:`~roughsea_torch.renderer.hits.read_at`."""
         dtype = self.dtype

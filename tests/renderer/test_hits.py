@@ -12,7 +12,8 @@ import torch
 
 import roughsea_torch as rs
 from roughsea_torch.raytrace import raytraced_image
-from roughsea_torch.renderer.hits import (Sweep, centre_element, covers, footprint_fade, in_blocks, nonzero_2d, pixel_hits,
+from roughsea_torch._parallel import in_blocks
+from roughsea_torch.renderer.hits import (Sweep, centre_element, covers, footprint_fade, nonzero_2d, pixel_hits,
                                           pixel_windows, read_at, sample_step, sweep_envelope, visible_average,
                                           visible_samples)
 
