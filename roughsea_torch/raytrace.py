@@ -321,6 +321,7 @@ def raytraced_image(  # ~100 lines: 22 lines of signature, the docstring, then e
     anisotropic: bool = True,
     rays_per_pixel: int = 64,
     k_max: float = 64.0,
+    slope_k_max: float | None = None,
     mode: str = "two_scale",
     shadowing: bool | str = True,
     ray_seed: int = 0,
@@ -352,6 +353,12 @@ def raytraced_image(  # ~100 lines: 22 lines of signature, the docstring, then e
         anisotropic: Cox–Munk law (as ``SeaScene``).
         rays_per_pixel: S ≥ 2 (the sampling variance needs two).
         k_max: largest traced wavenumber [rad m⁻¹]; ``inf`` traces every band.
+        slope_k_max: ``"two_scale"`` only: the hit's slope is that of the bands up to this
+            wavenumber [rad m⁻¹], ≤ ``k_max`` (default ``k_max``), and the bands above it are averaged by
+            the model whether traced or not: the rays meet the surface of every band up to ``k_max``
+            (their heights hide what lies behind them) but only the longer bands' slopes are explicit.
+            A diagnostic that separates what the short waves' heights and their slopes do to an image
+            (``pipelines/clutter_octaves.py``).
         mode: ``"two_scale"`` (the reference) or ``"specular"`` (module docstring).
         shadowing: the model's masking of the bands *not* traced, about the traced slope (and of the
             rays beyond ``max_range_m``): True (Eq. 5, default), "correlated" or "multiscale" (the
@@ -376,6 +383,11 @@ def raytraced_image(  # ~100 lines: 22 lines of signature, the docstring, then e
     """
     S = _check_arguments(cameras, wind_speed, wind_direction, sea_temperature, rays_per_pixel, k_max, mode, ray_seed,
                          tolerance_m, min_step_m, max_range_m)
+    if slope_k_max is not None:
+        check_positive("slope_k_max", slope_k_max, "rad/m", allow_inf=True)
+        if slope_k_max > k_max or mode != "two_scale":
+            raise ValueError(f"slope_k_max must be ≤ k_max = {k_max!r} [rad/m] and mode 'two_scale' (the slopes of bands the "
+                             f"rays do not meet would be seen unmasked); got {slope_k_max!r} with mode {mode!r}")
     shadowing = check_shadowing(shadowing)
     if shadowing is False:
         raise ValueError("shadowing: the untraced bands' masking must be True (Eq. 5), 'correlated' or 'multiscale'; "
@@ -391,6 +403,7 @@ def raytraced_image(  # ~100 lines: 22 lines of signature, the docstring, then e
         field = scene.wave_field(B, dt, dev)
     sky_fn = _sky_callable(sky, band, dt, dev)
     surf = TracedSurface(field, time_s, k_max)
+    slopes = surf if slope_k_max is None or slope_k_max >= k_max else TracedSurface(field, time_s, slope_k_max)
     total = SlopeStatistics.cox_munk(float(wind_speed), anisotropic=anisotropic)
     wdir = torch.full((B,), float(wind_direction), dtype=dt, device=dev)
     m = band_refractive_index(band, float(sea_temperature)).to(dev)
@@ -400,7 +413,7 @@ def raytraced_image(  # ~100 lines: 22 lines of signature, the docstring, then e
     rb = rb.detach()
     quad = quadrature or RADIANCE_QUADRATURE
     if mode == "two_scale":
-        unres = _unresolved_statistics(total, surf.traced_covariance.to(dt), wdir)
+        unres = _unresolved_statistics(total, slopes.traced_covariance.to(dt), wdir)
     rows_per_chunk = rows_per_chunk or max(1, (1 << 17) // max(1, W * S * B))
     check_count("rows_per_chunk", rows_per_chunk, 1)
 
@@ -416,6 +429,9 @@ def raytraced_image(  # ~100 lines: 22 lines of signature, the docstring, then e
         hit, sky_r, far = tr["hit"], tr["sky"], tr["far"]
         rad = torch.empty_like(cz)
         vz = torch.acos(cz.clamp(0.0, 1.0))
+        if slopes is not surf:  # the slopes of the bands ≤ slope_k_max at the hits
+            _, sx_, sy_ = slopes(*(torch.nan_to_num(tr[c]).reshape(B, -1) for c in ("x", "y")))
+            tr["slope_x"], tr["slope_y"] = sx_.reshape(cz.shape), sy_.reshape(cz.shape)
         # facets of the hits: t = cos θ̂ + sin θ̂ s∥ ≥ 0 faces the camera (s∥ along the LOS azimuth)
         s_up, s_cr = _rotate_to_wind(tr["slope_x"], tr["slope_y"], wdir[:, None, None, None])
         s_par = s_up * torch.cos(los_az) + s_cr * torch.sin(los_az)

@@ -212,6 +212,23 @@ def test_no_traced_waves_is_the_expectation_image():
     assert float(out["parallax_m"].abs().max()) < 1e-6
 
 
+def test_heights_alone_leave_the_expectation_image():
+    """In the two-scale model a ray's radiance depends on its direction and the slope statistics at its
+    hit, not on where it hits: with the rays meeting every band up to 64 rad/m (they do move: parallax)
+    but no band's slope taken (slope_k_max below the lowest band), the image is the expectation image,
+    as with nothing traced."""
+    q = rs.Quadrature.default(torch.float64)
+    cams = rs.make_camera(5, 6, hfov_deg=3e-4, altitude_m=15.0, pitch_deg=-5.0, yaw_deg=30.0, dtype=torch.float64)
+    out = rt.raytraced_image(cams, 8.0, seed=2, wind_direction=1.1, rays_per_pixel=2, k_max=64.0, slope_k_max=1e-3,
+                             quadrature=q)
+    scene = rs.SeaScene(wind_speed=8.0, wind_direction=1.1, sea_temperature=T_SEA, foam=False, path=False)
+    ref = rs.render(cams, scene, method="direct", quadrature=q, earth_radius_m=math.inf)
+    assert torch.allclose(out["radiance"], ref, rtol=2e-6, atol=0)
+    assert float(out["parallax_m"].min()) > 1e-3  # the hits are not the flat-sea points
+    traced = rt.raytraced_image(cams, 8.0, seed=2, wind_direction=1.1, rays_per_pixel=2, k_max=64.0, quadrature=q)
+    assert float((traced["radiance"] - ref).abs().max()) > 1e-3 * float(ref.mean())  # the slopes do change it
+
+
 def test_sampling_variance_estimates_the_noise():
     """radiance_var / S is the sampling variance of a pixel's mean: two ray seeds differ by about
     √(2 radiance_var / S) (i.i.d. sub-pixel points), over 768 pixels looking down at 45°, where a pixel
@@ -239,7 +256,9 @@ def test_dtypes_and_checks():
     for kwargs, name in ((dict(k_max=-1.0), "k_max"), (dict(rays_per_pixel=1), "rays_per_pixel"),
                          (dict(mode="mirror"), "mode"), (dict(sky=-3.0), "sky"), (dict(tolerance_m=0.0), "tolerance_m"),
                          (dict(min_step_m=float("nan")), "min_step_m"), (dict(max_range_m=-5.0), "max_range_m"),
-                         (dict(shadowing=False), "shadowing"), (dict(shadowing="wagner"), "shadowing")):
+                         (dict(shadowing=False), "shadowing"), (dict(shadowing="wagner"), "shadowing"),
+                         (dict(slope_k_max=128.0), "slope_k_max"), (dict(slope_k_max=-1.0), "slope_k_max"),
+                         (dict(k_max=math.inf, slope_k_max=4.0, mode="specular"), "slope_k_max")):
         with pytest.raises(ValueError, match=name):
             rt.raytraced_image(cams, 10.0, seed=1, **kwargs)
     with pytest.raises(ValueError, match="cameras"):  # below the crests
