@@ -2,7 +2,8 @@
 
 From 20 m the horizon is 0.14° below the horizontal and 16 km away; from 2 km it is 1.44° down
 and 160 km away, and every sea pixel is seen at a steeper angle. Writes ``altitude_compare.png``
-(brightness temperature) and ``altitude_compare_range.png`` (slant range, km) to ``--out``.
+(brightness temperature, one colour range) and ``altitude_compare_range.png`` (slant range, km, each
+panel its own colour range: 16 km and 160 km horizons) to ``--out``.
 
 Usage:
     python examples/altitude_compare.py [--out outputs/examples] [--sky midlatitude_summer]
@@ -34,7 +35,8 @@ def main() -> None:
     titles = [f"altitude {a:.0f} m (horizon dip {d:.2f}°)" for a, d in zip(alt.tolist(), dip.tolist())]
     save_grid(bt, titles, args.out / "altitude_compare.png", label="brightness temperature [K]", ncols=2)
     rng = torch.where(geom.is_sea, geom.range_m / 1000.0, torch.tensor(math.nan))[:, None]
-    save_grid(rng, titles, args.out / "altitude_compare_range.png", label="slant range [km]", ncols=2, cmap="viridis")
+    save_grid(rng, titles, args.out / "altitude_compare_range.png", label="slant range [km]", ncols=2, cmap="viridis",
+              shared_scale=False)
     print(f"wrote {args.out}/altitude_compare.png and altitude_compare_range.png")
 
 

@@ -7,7 +7,9 @@ brightness-temperature deficit versus view zenith angle for a flat sea and sever
 the paper's Eq. 12). Writes ``fig3_<atmosphere>_<band>.png`` to ``--out``.
 
 Usage:
-    python examples/fig3_grazing.py [--out outputs/examples] [--atmospheres midlatitude_summer] [--bands LWIR]
+    python examples/fig3_grazing.py [--out outputs/examples] [--atmospheres midlatitude_summer ...] [--bands LWIR MWIR]
+
+(by default every shipped atmosphere and both bands: twelve pictures)
 """
 
 from __future__ import annotations

@@ -10,7 +10,9 @@ pixel: sparse flashes), smooth and with glitter, their own colour range. The gli
 to the sea points the pixels see (``docs/glitter.md``).
 
 Usage:
-    python examples/glitter_clip.py [--out docs] [--frames 3] [--dt 0.1]
+    python examples/glitter_clip.py [--out outputs/examples] [--frames 3] [--dt 0.1]
+
+(``--out docs`` rewrites the repository's ``docs/glitter_clip.png``)
 """
 
 from __future__ import annotations

@@ -18,6 +18,7 @@ import argparse
 import math
 from pathlib import Path
 
+import numpy as np
 import torch
 
 import roughsea_torch as rs
@@ -35,7 +36,7 @@ def main() -> None:
     scene = rs.SeaScene(wind_speed=8.0, sea_temperature=290.0)
     imgs = {m: rs.render(cams, scene, output="brightness_temperature", horizon=m)[0, 0] for m in ("centre", "area")}
     r0, c0, rows, cols = H // 2 - 6, W // 2 - 30, 12, 60
-    crop = {m: im[r0:r0 + rows, c0:c0 + cols] for m, im in imgs.items()}
+    crop = {m: im[r0:r0 + rows, c0:c0 + cols].numpy() for m, im in imgs.items()}  # matplotlib takes numpy arrays
     vmin = float(min(c.min() for c in crop.values()))
     vmax = float(max(c.max() for c in crop.values()))
     fig, axes = plt.subplots(4, 1, figsize=(8.0, 9.0), gridspec_kw={"height_ratios": [1, 1, 1, 1.3]})
@@ -47,17 +48,17 @@ def main() -> None:
         ax.set_yticks([])
         fig.colorbar(im, ax=ax, label="K", fraction=0.03)
     diff = crop["area"] - crop["centre"]
-    lim = float(diff.abs().max())
+    lim = float(abs(diff).max())
     im = axes[2].imshow(diff, cmap="RdBu_r", vmin=-lim, vmax=lim, interpolation="nearest")
     axes[2].set_title("area − centre [K] (zero off the horizon, bit for bit)", fontsize=9)
     axes[2].set_xticks([])
     axes[2].set_yticks([])
     fig.colorbar(im, ax=axes[2], label="K", fraction=0.03)
-    x = torch.arange(c0, c0 + cols)
+    x = range(c0, c0 + cols)
     for m, style in (("centre", "-o"), ("area", "-s")):
         means = crop[m].mean(0)
         axes[3].plot(x, means, style, ms=3, lw=1, label=f'horizon="{m}"')
-        print(f'horizon="{m}": largest step of the column means {float(means.diff().abs().max()):.3f} K')
+        print(f'horizon="{m}": largest step of the column means {float(abs(np.diff(means)).max()):.3f} K')
     axes[3].set_xlabel("image column")
     axes[3].set_ylabel(f"mean of {rows} rows [K]")
     axes[3].set_title(f"column means across the horizon, roll {roll:g}° (0.07 row a column)", fontsize=9)

@@ -16,7 +16,9 @@ where foam and water differ by under 1 K (``docs/foam_table.md``).
 its active and residual cover and the foam's brightness change (foam − no foam), to follow a patch.
 
 Usage:
-    python examples/storm_clip.py [--out docs] [--height 128] [--width 160] [--rows]
+    python examples/storm_clip.py [--out outputs/examples] [--height 192] [--width 240] [--rows]
+
+(``--out docs`` rewrites the repository's ``docs/storm_clip.png``)
 """
 
 from __future__ import annotations

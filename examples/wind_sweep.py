@@ -3,6 +3,9 @@
 Writes ``wind_sweep.png`` (brightness temperature images on one colour scale) and
 ``wind_sweep_profile.png`` (the central column's brightness temperature vs image row) to ``--out``.
 
+The 30 m/s image is past the whitecap law's range: the package warns ("wind_speed above 25 m/s ...")
+and holds the whitecap fraction at its 25 m/s value; the warning is expected.
+
 Usage:
     python examples/wind_sweep.py [--out outputs/examples] [--sky midlatitude_summer]
 """
