@@ -115,7 +115,8 @@ class SpectralBand:
         if self.lo < 1e-7 or self.hi > 1e-3:
             raise ValueError(
                 f"band: limits must be wavelengths in metres within [1e-7, 1e-3]; got ({self.lo!r}, {self.hi!r}). "
-                "Did you pass micrometres?"
+                + ("" if self.hi <= 1e-3 else "Did you pass micrometres? " if self.hi <= 100.0 else "Did you pass nanometres? ")
+                + "(8-12 µm is (8e-6, 12e-6))"
             )
 
     @property

@@ -137,6 +137,7 @@ def test_zero_response_raises():
     [
         (lambda: rs.band_radiance(300.0, (12.0, 8.0)), "band"),
         (lambda: rs.band_radiance(300.0, (8.0, 12.0)), "micrometres"),
+        (lambda: rs.band_radiance(300.0, (8000.0, 12000.0)), "nanometres"),
         (lambda: rs.brightness_temperature(-3.0), "radiance"),
     ],
 )

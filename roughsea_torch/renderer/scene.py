@@ -475,7 +475,7 @@ class SeaScene:
         if own not in (1, B):
             names = " and ".join(k for k, v in self.field_sizes().items() if v == own)
             raise ValueError(f"SeaScene: {names} {'have' if ' and ' in names else 'has'} batch size {own} (one value per "
-                             f"image) but the cameras have {B} images; give one value per camera"
+                             f"image) but the cameras have {B} image{'s' if B != 1 else ''}; give one value per camera"
                              + (", or one int seed (seeds are then derived per image)" if "seed" in names else ""))
         if isinstance(self.seed, list):
             self.seeds(B)  # exactly B seeds, checked before any work
