@@ -5,7 +5,10 @@ camera pose, under the shipped LOWTRAN7 midlatitude-summer sky, each a textured 
 (wave clutter; ``--no-texture`` renders the expectation images, the mean over the slope
 statistics). Writes to ``--out``:
 
-- ``grid_brightness_temperature.png``: the batch as a picture grid (brightness temperature, K);
+- ``grid_brightness_temperature.png``: the batch as a picture grid (brightness temperature, K), one
+  colour range for all;
+- ``grid_sea_detail.png``: the same, each panel's colour range from its lower half (sea: the clutter
+  shows; the sky clips to either end of the bar);
 - ``image_XX.png``: each image as a 16-bit grayscale PNG, linear in brightness temperature between
   the ``bt_lo`` and ``bt_hi`` of ``metadata.json``;
 - ``metadata.json``: every parameter that made each image.
@@ -26,7 +29,7 @@ from pathlib import Path
 import torch
 
 import roughsea_torch as rs
-from _common import save_grid, save_png16
+from _common import colour_range, save_grid, save_png16
 
 
 def default_batch(batch: int, seed: int = 0) -> dict[str, torch.Tensor]:
@@ -77,6 +80,9 @@ def main() -> None:
     ]
     args.out.mkdir(parents=True, exist_ok=True)
     save_grid(bt, titles, args.out / "grid_brightness_temperature.png", label="brightness temperature [K]")
+    sea = [colour_range(img[0, args.height // 2:], (1.0, 99.0)) for img in bt]  # the lower half: sea at these pitches
+    save_grid(bt, titles, args.out / "grid_sea_detail.png", label="brightness temperature [K]", ranges=sea,
+              note="each panel's colour range from its lower half (1–99 %): the sea's clutter; the sky clips")
     lo, hi = 250.0, 310.0
     res = scene.resolved(args.batch, torch.float32, torch.device("cpu"))
     air = rs.atmosphere.surface_air_temperature(args.sky) if isinstance(sky, str) else None  # [K], the atmosphere's
@@ -91,7 +97,7 @@ def main() -> None:
                               | ({"air_temperature": float(air)} if air is not None else {})
                               | ({"wave_seed": wave_seeds[i], "time_s": 0.0} if wave_seeds else {}))
     (args.out / "metadata.json").write_text(json.dumps(meta, indent=2))
-    print(f"wrote {args.out}/grid_brightness_temperature.png, {args.batch} 16-bit PNGs and metadata.json")
+    print(f"wrote {args.out}/grid_brightness_temperature.png, grid_sea_detail.png, {args.batch} 16-bit PNGs and metadata.json")
 
 
 if __name__ == "__main__":
