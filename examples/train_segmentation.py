@@ -90,7 +90,8 @@ def normalise(counts: torch.Tensor) -> torch.Tensor:
 def make_augmentation(seed: int = 0, texture: bool = True) -> RandomSeaBackground:
     return RandomSeaBackground(
         texture=texture,
-        wind_speed=(1.0, 14.0), sea_temperature=(286.0, 298.0), air_temperature=(284.0, 300.0),
+        # the air a few kelvin from the sea, mostly colder, as over the open sea: T_air = T_sea + [-3, 1] K
+        wind_speed=(1.0, 14.0), sea_temperature=(286.0, 298.0), air_sea_difference=(-3.0, 1.0),
         atmospheres=["midlatitude_summer", "tropical", "us_standard"], altitude_m=(8.0, 40.0),
         pitch_deg=(-6.0, -2.0), roll_deg=(-1.5, 1.5), hfov_deg=(12.0, 24.0),
         mode="composite", sensor=SensorModel.typical_lwir(seed=seed),
@@ -157,7 +158,8 @@ def save_batch_grid(counts: torch.Tensor, mask: torch.Tensor, params: dict, path
             continue
         ax.imshow(disp[i, 0].numpy(), cmap="gray", vmin=0, vmax=255)
         ax.contour(mask[i, 0].float().numpy(), levels=[0.5], colors="tab:red", linewidths=0.6)
-        ax.set_title(f"W {float(params['wind_speed'][i]):.1f} m/s  T_sea {float(params['sea_temperature'][i]):.1f} K\n"
+        ax.set_title(f"W {float(params['wind_speed'][i]):.1f} m/s  T_sea {float(params['sea_temperature'][i]):.1f} K  "
+                     f"T_air - T_sea {float(params['air_sea_difference'][i]):+.1f} K\n"
                      f"h {float(params['altitude_m'][i]):.0f} m  pitch {float(params['pitch_deg'][i]):.1f}°", fontsize=7)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)

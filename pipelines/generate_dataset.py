@@ -9,7 +9,10 @@ probability that an image is by day, default 0: all by night) puts the sun in th
 elevation drawn from ``scene.sun_elevation_deg`` and an azimuth from ``scene.sun_azimuth_deg``
 (relative to the camera's yaw: 0 is straight ahead, where its glint is); each image's ``is_day``,
 sun elevation, zenith and world azimuth are in the metadata (``pipelines/configs/sea_mwir_day.toml``:
-MWIR by day, the glint of a low sun ahead).
+MWIR by day, the glint of a low sun ahead). The air: ``scene.air_sea_difference`` (T_air − T_sea [K],
+the shipped configs' [-3, 1]) draws each image's air temperature as its sea temperature plus a
+difference; ``scene.air_temperature`` draws it on its own (not both); with neither, each atmosphere's
+own surface air temperature. Each image's ``air_sea_difference`` is in the metadata.
 
 One process (with DataLoader workers rendering shards in parallel):
 
@@ -59,6 +62,9 @@ def default_config_toml() -> str:
     head = "# roughsea_torch dataset config: every key with its default (python pipelines/generate_dataset.py --print-default-config)\n"
     if unset:
         head += "# not set by default (give a value to set them): " + ", ".join(unset) + "\n"
+    if {"scene.air_temperature", "scene.air_sea_difference"} <= set(unset):
+        head += ("# the air: scene.air_sea_difference = [low, high] K draws T_air - T_sea (e.g. [-3.0, 1.0], over the open\n"
+                 "# sea), scene.air_temperature draws T_air on its own (not both); neither: each atmosphere's own\n")
     return head + "\n" + body
 
 

@@ -11,14 +11,15 @@ from typing import Any, Sequence
 
 import torch
 
-from .sampling import MOTION_FIELD_NAMES, SCENE_FIELD_NAMES
+from .sampling import MOTION_FIELD_NAMES, RENDER_FIELD_NAMES
 from .waves import check_time
 
 __all__ = ["check_input", "check_params", "check_output_settings", "check_composite_gate", "REQUIRED_PARAMS", "PER_IMAGE_PARAMS"]
 
-# the per-image fields a draw may hold, each a tensor (B,); the first ones are always there
-REQUIRED_PARAMS = (*SCENE_FIELD_NAMES, "atmosphere", "noise_seed")
-PER_IMAGE_PARAMS = (*REQUIRED_PARAMS, "wave_seed", "time_s", *MOTION_FIELD_NAMES, "phase_rad", "is_day",
+# the per-image fields a draw may hold, each a tensor (B,); the first ones are always there (the air-sea
+# difference, a record of T_air - T_sea that the render does not use, is not required of a replayed draw)
+REQUIRED_PARAMS = (*RENDER_FIELD_NAMES, "atmosphere", "noise_seed")
+PER_IMAGE_PARAMS = (*REQUIRED_PARAMS, "air_sea_difference", "wave_seed", "time_s", *MOTION_FIELD_NAMES, "phase_rad", "is_day",
                     "sun_elevation_deg", "sun_azimuth_deg")
 
 

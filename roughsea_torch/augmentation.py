@@ -95,10 +95,15 @@ class RandomSeaBase:
     draw, and the stages after the renderer (compositing, sensor, output unit).
 
     Shared keyword arguments (every one has the same default in both classes):
-        wind_speed, wind_direction_deg, sea_temperature, air_temperature, altitude_m, pitch_deg,
-            roll_deg, yaw_deg, hfov_deg, atmospheres: ranges of the scene (a number, held fixed,
-            or a ``(low, high)`` pair, drawn uniformly; defaults in :data:`SCENE_FIELDS`), see
-            :class:`SceneSampler`.
+        wind_speed, wind_direction_deg, sea_temperature, air_temperature, air_sea_difference,
+            altitude_m, pitch_deg, roll_deg, yaw_deg, hfov_deg, atmospheres: ranges of the scene (a
+            number, held fixed, or a ``(low, high)`` pair, drawn uniformly; defaults in
+            :data:`SCENE_FIELDS`), see :class:`SceneSampler`. The air [K]: by default each
+            atmosphere's own surface air temperature; ``air_temperature`` draws it on its own;
+            ``air_sea_difference`` (T_air − T_sea [K], e.g. ``(-3.0, 1.0)``, the usual range over the
+            open sea) draws it as each image's sea temperature plus a difference, so that air and
+            sea stay a few kelvin apart. Not both (``ValueError``). ``params["air_sea_difference"]``
+            records T_air − T_sea of every image (the render uses ``params["air_temperature"]``).
         texture: ``True`` (default): a textured sea, one realization of the wave field per image
             (``SeaScene(seed=...)``: waves longer than a pixel's footprint are geometry, the clutter
             a real camera sees at near range, around the expectation image); the wave seed
@@ -166,6 +171,7 @@ class RandomSeaBase:
         wind_direction_deg: Any = SCENE_FIELDS[1][3],
         sea_temperature: Any = SCENE_FIELDS[2][3],
         air_temperature: Any = SCENE_FIELDS[3][3],
+        air_sea_difference: Any = SCENE_FIELDS[9][3],
         altitude_m: Any = SCENE_FIELDS[4][3],
         pitch_deg: Any = SCENE_FIELDS[5][3],
         roll_deg: Any = SCENE_FIELDS[6][3],
@@ -194,7 +200,8 @@ class RandomSeaBase:
         a clip's platform motion (``SceneSampler(motion=)``), None for still images."""
         self.sampler = SceneSampler(
             atmospheres=atmospheres, wind_speed=wind_speed, wind_direction_deg=wind_direction_deg,
-            sea_temperature=sea_temperature, air_temperature=air_temperature, altitude_m=altitude_m,
+            sea_temperature=sea_temperature, air_temperature=air_temperature,
+            air_sea_difference=air_sea_difference, altitude_m=altitude_m,
             pitch_deg=pitch_deg, roll_deg=roll_deg, yaw_deg=yaw_deg, hfov_deg=hfov_deg, path=path, band=band,
             texture=texture, time_s=time_s, motion=motion, daytime=daytime, sun_elevation_deg=sun_elevation_deg,
             sun_azimuth_deg=sun_azimuth_deg, sun_azimuth_relative_to_yaw=sun_azimuth_relative_to_yaw,

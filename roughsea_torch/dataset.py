@@ -10,7 +10,9 @@ Layout of an output directory::
     shard_000000.npz ...      numpy archives, one per ``shard_size`` items: ``images`` uint16
                               sensor counts, (N, H, W) for still images or (N, T, H, W) for clips
                               of T = ``clip_length`` frames; per item ``index``, every scene
-                              parameter (float64), ``atmosphere`` (name), ``noise_seed`` (int64),
+                              parameter (float64; ``air_sea_difference`` is T_air − T_sea
+                              [K] of the item, drawn or not), ``atmosphere`` (name),
+                              ``noise_seed`` (int64),
                               ``image_seed`` (uint64); with ``scene.texture``: ``wave_seed``
                               (int64) and ``time_s`` [s] (float64); with ``scene.daytime`` > 0:
                               ``is_day`` (bool), ``sun_elevation_deg``, ``sun_zenith_deg`` and
@@ -60,7 +62,7 @@ import torch
 from ._version import __version__
 from .dataset_config import DEFAULT_CONFIG, build_sensor, config_band, config_sampler, config_table, resolve_config
 from .parameter_render import render_clip_parameters, render_parameters
-from .sampling import MOTION_FIELDS, SCENE_FIELDS, frame_parameters, image_seed
+from .sampling import MOTION_FIELDS, RENDER_FIELD_NAMES, SCENE_FIELDS, frame_parameters, image_seed
 
 __all__ = ["DEFAULT_CONFIG", "resolve_config", "build_sensor", "generate", "SeaShardDataset", "shard_name",
            "frame_render_parameters"]
@@ -153,7 +155,8 @@ def frame_render_parameters(meta: dict[str, Any], frame: int | None = None) -> d
     still image or, with ``frame``, frame ``frame`` of a clip: its pose and time replaced by the
     frame's.
 
-    Returns a dict of tensors of shape (1,): the scene fields of :data:`SCENE_FIELDS` (float64),
+    Returns a dict of tensors of shape (1,): the scene fields of :data:`SCENE_FIELDS` (float64;
+    ``air_sea_difference`` only if the metadata holds it: shards written before it existed do not),
     ``noise_seed`` (int64: the item's, or with ``frame`` the frame's ``frame_noise_seed[frame]``,
     the seed of that frame's sensor noise); a textured item (``wave_seed`` in its metadata) also
     gives ``wave_seed`` (int64) and ``time_s`` (float64 [s], the frame's with ``frame``); a day item
@@ -161,7 +164,8 @@ def frame_render_parameters(meta: dict[str, Any], frame: int | None = None) -> d
     ``sun_azimuth_deg`` (world). The atmosphere is NOT in it (``render_parameters`` needs it as an
     index, which depends on the atmospheres you render with): the metadata's ``"atmosphere"`` is
     its name, so add ``p["atmosphere"] = torch.tensor([atmospheres.index(meta["atmosphere"])])``."""
-    p = {k: torch.tensor([float(meta[k])], dtype=torch.float64) for k, *_r in SCENE_FIELDS}
+    p = {k: torch.tensor([float(meta[k])], dtype=torch.float64) for k, *_r in SCENE_FIELDS
+         if k in RENDER_FIELD_NAMES or k in meta}
     if "wave_seed" in meta:
         p["wave_seed"] = torch.tensor([int(meta["wave_seed"])], dtype=torch.int64)
         p["time_s"] = torch.tensor([float(meta["time_s"])], dtype=torch.float64)

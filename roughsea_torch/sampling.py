@@ -1,7 +1,8 @@
 """Random scene parameters: the field tables, :class:`SceneSampler` and the seeds of images and frames.
 
 :class:`SceneSampler` draws scene and pose parameters (wind, sea and air temperature, atmosphere,
-altitude, pitch, roll, yaw, field of view; with ``texture`` a wave seed and a time; with
+altitude, pitch, roll, yaw, field of view; the air either on its own or as the sea's temperature
+plus an air–sea difference; with ``texture`` a wave seed and a time; with
 ``motion`` a platform's pitch, roll and heave oscillations; with ``daytime`` the sun) uniformly
 from ranges the user gives. It is separate from the deterministic rendering of a draw
 (:mod:`roughsea_torch.parameter_render`), as kornia separates parameter generation from the
@@ -39,12 +40,15 @@ __all__ = [
     "MOTION_FIELDS",
     "SUN_FIELDS",
     "SCENE_FIELD_NAMES",
+    "RENDER_FIELD_NAMES",
     "MOTION_FIELD_NAMES",
     "TIME_RANGE_S",
     "DEFAULT_TIME_S",
 ]
 
-# (name, allowed range, unit, default range); the order is the order of the draws
+# (name, allowed range, unit, default range); one uniform is drawn per field, in this order, except for
+# air_sea_difference (T_air − T_sea), which takes air_temperature's: the two exclude each other, so the
+# difference adds no draw, and a sampler without it draws what the samplers before it drew
 SCENE_FIELDS: tuple[tuple[str, tuple[float, float], str, Any], ...] = (
     ("wind_speed", (0.0, MAX_WIND_SPEED), "m/s", (1.0, 15.0)),
     ("wind_direction_deg", (-3600.0, 3600.0), "deg", (0.0, 360.0)),
@@ -55,6 +59,7 @@ SCENE_FIELDS: tuple[tuple[str, tuple[float, float], str, Any], ...] = (
     ("roll_deg", (-180.0, 180.0), "deg", (-2.0, 2.0)),
     ("yaw_deg", (-3600.0, 3600.0), "deg", 0.0),
     ("hfov_deg", (0.5, 179.0), "deg", (20.0, 40.0)),
+    ("air_sea_difference", (-30.0, 30.0), "K", None),
 )
 # the platform's oscillations of a clip (motion.PlatformMotion), drawn after the scene's fields,
 # then one phase φ ∈ [0, 2π) [rad]; the defaults are a ship's first-order response to a swell
@@ -74,6 +79,9 @@ SUN_FIELDS: tuple[tuple[str, tuple[float, float], str, Any], ...] = (
 TIME_RANGE_S = (0.0, 86400.0)  # allowed range of the realizations' times [s]
 DEFAULT_TIME_S = (0.0, 3600.0)  # default range of the realizations' times [s]
 SCENE_FIELD_NAMES = tuple(f[0] for f in SCENE_FIELDS)  # the names alone, in the order of the draws
+# the scene fields a render uses: all but air_sea_difference, which a draw holds as a record (T_air − T_sea)
+RENDER_FIELD_NAMES = tuple(n for n in SCENE_FIELD_NAMES if n != "air_sea_difference")
+_DRAWN_FIELD_NAMES = RENDER_FIELD_NAMES  # one uniform each, in this order (the difference uses the air's)
 MOTION_FIELD_NAMES = tuple(f[0] for f in MOTION_FIELDS)
 _MIX = 0x9E3779B97F4A7C15  # golden-ratio constant of splitmix64
 _MASK = (1 << 64) - 1
@@ -151,8 +159,18 @@ class SceneSampler:
             Cox–Munk was fitted up to ~14 m s⁻¹).
         wind_direction_deg: upwind azimuth [deg] in the world frame.
         sea_temperature: T_sea [K], in [260, 320].
-        air_temperature: T_air [K] of the surface air, in [230, 330]; ``None`` (default): each
-            atmosphere's own surface air temperature (see ``SeaScene``).
+        air_temperature: T_air [K] of the surface air, in [230, 330], drawn independently of the
+            sea; ``None`` (default): each atmosphere's own surface air temperature (see
+            ``SeaScene``), unless ``air_sea_difference`` is given.
+        air_sea_difference: ΔT = T_air − T_sea [K], in [−30, 30]: each image's air temperature is
+            its drawn sea temperature plus a ΔT drawn uniformly from this range (independent of the
+            sea). Over the open sea the surface air is within a few kelvin of the water, mostly a
+            little colder: ``(-3.0, 1.0)`` covers the usual cases (large positive ΔT only in warm air
+            advected over cold water, large negative ones in cold-air outbreaks). ``None``
+            (default): not used, and the draws are those of a sampler without this argument, bit
+            for bit (ΔT takes the uniform that ``air_temperature`` would, drawn either way).
+            Giving both ``air_temperature`` and ``air_sea_difference`` is a ``ValueError``, and so is
+            a ΔT range that takes ``sea_temperature`` outside the air's [230, 330] K.
         altitude_m: sensor height above the sea [m], in [2, 5000] with the atmospheric path on (the
             altitudes its tables cover), in [0.5, 20000] with ``path=False`` (a camera below the
             sea, or outside the path tables, is refused here, before any work).
@@ -188,11 +206,12 @@ class SceneSampler:
             towards +y, the yaw's frame).
         sun_azimuth_relative_to_yaw: see ``sun_azimuth_deg``.
 
-    ``sample(B, generator)`` returns a dict of CPU float64 tensors (B,) under these names plus
-    ``"atmosphere"`` (int64 index into ``atmospheres``) and ``"noise_seed"`` (int64, for the sensor
+    ``sample(B, generator)`` returns a dict of CPU float64 tensors (B,) under these names (the
+    ``"air_sea_difference"`` of every image, T_air − T_sea [K], also without the argument: a record,
+    the renderer uses ``"air_temperature"``) plus ``"atmosphere"`` (int64 index into ``atmospheres``) and ``"noise_seed"`` (int64, for the sensor
     model's random stages). Every field is drawn on every call, fixed or not, so fixing one range
-    does not change the draws of the others. The draws are made in this order: the scene fields,
-    the atmosphere, the noise seed, then (``texture``) the wave seed and the time, then
+    does not change the draws of the others. The draws are made in this order: the scene fields
+    (one uniform each, ``air_sea_difference`` sharing ``air_temperature``'s), the atmosphere, the noise seed, then (``texture``) the wave seed and the time, then
     (``motion``) the oscillations and the phase, then (``daytime`` > 0) whether the image is by
     day and the sun's elevation and azimuth: turning texture, motion or daytime on does not change
     the draws before theirs. With ``daytime`` > 0 the draw also holds ``"is_day"`` (bool),
@@ -209,6 +228,11 @@ class SceneSampler:
         ...     3, generator=torch.Generator().manual_seed(0))
         >>> torch.equal(q["wind_speed"], p["wind_speed"]), q["wave_seed"].dtype, q["time_s"].dtype
         (True, torch.int64, torch.float64)
+        >>> a = SceneSampler(sea_temperature=(285.0, 302.0), air_sea_difference=(-3.0, 1.0)).sample(
+        ...     1000, generator=torch.Generator().manual_seed(0))
+        >>> d = a["air_temperature"] - a["sea_temperature"]  # T_air - T_sea [K]
+        >>> bool((d >= -3.0 - 1e-9).all() and (d <= 1.0 + 1e-9).all())
+        True
     """
 
     def __init__(self, *, atmospheres: Sequence[str] | str = ("midlatitude_summer",), path: bool = True,
@@ -244,6 +268,7 @@ class SceneSampler:
         for name, allowed, unit, default in SCENE_FIELDS:
             value = ranges.get(name, default)
             self.ranges[name] = None if value is None else as_range(name, value, allowed, unit)
+        self._check_air_sea_difference()
         self.path = path
         self.texture = texture
         self.time_s = as_range("time_s", time_s, TIME_RANGE_S, "s")
@@ -264,6 +289,24 @@ class SceneSampler:
         self.motion: dict[str, tuple[float, float]] | None = None
         if motion is not None:
             self.motion = self._motion_ranges(motion)
+
+    def _check_air_sea_difference(self) -> None:
+        """``ValueError`` for ``air_temperature`` and ``air_sea_difference`` given together, or for a
+        difference that takes the sea's range outside the air's allowed range."""
+        diff = self.ranges["air_sea_difference"]
+        if diff is None:
+            return
+        if self.ranges["air_temperature"] is not None:
+            raise ValueError("air_temperature and air_sea_difference: give one of them, not both (air_temperature "
+                             "draws T_air on its own, air_sea_difference draws T_air - T_sea and adds it to each "
+                             f"image's sea temperature); got air_temperature={self.ranges['air_temperature']} K and "
+                             f"air_sea_difference={diff} K")
+        (s_lo, s_hi), (a_lo, a_hi) = self.ranges["sea_temperature"], SCENE_FIELDS[3][1]
+        if s_lo + diff[0] < a_lo or s_hi + diff[1] > a_hi:
+            raise ValueError(f"air_sea_difference: sea_temperature ({s_lo:g}, {s_hi:g}) K + air_sea_difference "
+                             f"({diff[0]:g}, {diff[1]:g}) K gives air temperatures in [{s_lo + diff[0]:g}, "
+                             f"{s_hi + diff[1]:g}] K, outside the allowed [{a_lo:g}, {a_hi:g}] K of air_temperature; "
+                             "narrow one of them")
 
     def _motion_ranges(self, motion: Any) -> dict[str, tuple[float, float]]:
         if not isinstance(motion, dict):
@@ -307,16 +350,23 @@ class SceneSampler:
         if generator is not None and generator.device.type != "cpu":
             raise ValueError("generator must be a CPU torch.Generator (parameters are drawn on the CPU, then moved)")
         n = 1 if same_on_batch else batch_size
-        u = torch.rand(len(SCENE_FIELDS), n, generator=generator, dtype=torch.float64)
+        u = torch.rand(len(_DRAWN_FIELD_NAMES), n, generator=generator, dtype=torch.float64)
         atm = torch.randint(len(self.atmospheres), (n,), generator=generator)
         seeds = torch.randint(0, 2**62, (n,), generator=generator)
+        # T_air - T_sea, when given, from the uniform an air range would take (drawn either way)
+        diff_range = self.ranges["air_sea_difference"]
+        diff = None if diff_range is None else _uniform(diff_range, u[_DRAWN_FIELD_NAMES.index("air_temperature")])
         out: dict[str, torch.Tensor] = {}
-        for i, (name, *_rest) in enumerate(SCENE_FIELDS):
+        for i, name in enumerate(_DRAWN_FIELD_NAMES):
             r = self.ranges[name]
-            if r is None:  # air temperature of each image's atmosphere
-                out[name] = self.atmosphere_air_temperature[atm]
-            else:
+            if r is not None:
                 out[name] = _uniform(r, u[i])
+            elif diff is not None:  # (only air_temperature may be None) the air: the sea plus the difference
+                out[name] = out["sea_temperature"] + diff
+            else:  # air temperature of each image's atmosphere
+                out[name] = self.atmosphere_air_temperature[atm]
+        # the record of T_air - T_sea: the drawn difference, else what the air and sea drawn make
+        out["air_sea_difference"] = diff if diff is not None else out["air_temperature"] - out["sea_temperature"]
         out["atmosphere"] = atm
         out["noise_seed"] = seeds
         if self.texture:  # after the draws above, so that they do not change with the texture

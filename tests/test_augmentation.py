@@ -392,6 +392,29 @@ def test_constructors_list_their_arguments():
             cls(wind=3.0, p=0.5)
 
 
+def test_air_sea_difference_reaches_the_rendered_seas():
+    """RandomSeaBackground(air_sea_difference=) draws each image's air as its sea plus the difference
+    (kept in ``_params``, replayed), and the render uses that air: with the same generator (the same
+    sea, wind, pose and atmosphere), air 5 K above the sea makes every pixel brighter than air 5 K
+    below it (the sky the sea reflects and the path to the camera scale with B(T_air) / B(T_atm),
+    docs/physics.md, *Air temperature*). RandomSeaClip forwards the range too."""
+    x = torch.zeros(3, 1, H, W)
+    kw = dict(sea_temperature=(285.0, 300.0), atmospheres=["midlatitude_summer", "subarctic_winter"], texture=False)
+    warm, cold = small(air_sea_difference=5.0, **kw), small(air_sea_difference=-5.0, **kw)
+    y_warm, y_cold = warm(x, generator=gen(4)), cold(x, generator=gen(4))
+    for aug, d in ((warm, 5.0), (cold, -5.0)):
+        p = aug._params
+        torch.testing.assert_close(p["air_temperature"] - p["sea_temperature"], torch.full((3,), d, dtype=torch.float64),
+                                   rtol=0, atol=1e-9)
+    assert torch.equal(warm._params["sea_temperature"], cold._params["sea_temperature"])
+    assert bool((y_warm > y_cold).all())
+    assert torch.equal(warm(x, params={k: v.clone() for k, v in warm._params.items()}), y_warm)
+    c = clip(air_sea_difference=(-3.0, 1.0), sea_temperature=(285.0, 300.0), texture=False, frame_rate=5.0)
+    c(torch.zeros(4, 2, 1, 8, 10), generator=gen(2))
+    d = c._params["air_temperature"] - c._params["sea_temperature"]
+    assert float(d.min()) >= -3.0 - 1e-9 and float(d.max()) <= 1.0 + 1e-9
+
+
 # ------------------------------------------------------------------------------------------------
 # Clips: RandomSeaClip
 # ------------------------------------------------------------------------------------------------

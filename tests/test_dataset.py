@@ -416,3 +416,24 @@ def test_dataset_workers_warnings_point_at_the_callers_line():
     scaled = [w for w in caught if "scaled down" in str(w.message)]
     assert scaled and all(w.filename == __file__ for w in scaled)
 
+
+
+def test_air_sea_difference_reaches_the_metadata(tmp_path):
+    """scene.air_sea_difference: config.json records the range, each item's metadata its air (its
+    sea plus a difference within the range) and the difference T_air − T_sea; re-rendering from the
+    metadata gives the counts, also from metadata without the record (shards written before it)."""
+    cfg = {"seed": 2, "num_images": 3, "shard_size": 3, "batch_size": 3, "camera": {"height": 10, "width": 12},
+           "scene": {"texture": False, "sea_temperature": [285.0, 302.0], "air_sea_difference": [-3.0, 1.0]}}
+    generate(cfg, tmp_path, progress=False)
+    assert json.loads((tmp_path / "config.json").read_text())["config"]["scene"]["air_sea_difference"] == [-3.0, 1.0]
+    sensor = build_sensor(resolve_config(cfg))
+    for img, meta in SeaShardDataset(tmp_path):
+        d = meta["air_temperature"] - meta["sea_temperature"]
+        assert -3.0 - 1e-9 <= d <= 1.0 + 1e-9 and abs(meta["air_sea_difference"] - d) < 1e-9
+        old = {k: v for k, v in meta.items() if k != "air_sea_difference"}
+        for m in (meta, old):
+            p = frame_render_parameters(m)
+            p["atmosphere"] = torch.tensor([0])
+            c = sensor(render_parameters(p, 10, 12, ("midlatitude_summer",)),
+                       generator=torch.Generator().manual_seed(int(meta["noise_seed"])))
+            assert torch.equal(c[0].round(), img)

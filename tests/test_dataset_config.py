@@ -29,8 +29,9 @@ def test_print_default_config_is_complete_and_valid():
     printed = tomllib.loads(out.stdout)
     from roughsea_torch.dataset import DEFAULT_CONFIG, resolve_config
 
-    assert "scene.air_temperature" in out.stdout.split("\n\n")[0]  # the unset key, named in the header comment
-    printed_unset = {**printed, "scene": {**printed["scene"], "air_temperature": None}}
+    head = out.stdout.split("\n\n")[0]
+    assert "scene.air_temperature" in head and "scene.air_sea_difference" in head  # the unset keys, named in the header
+    printed_unset = {**printed, "scene": {**printed["scene"], "air_temperature": None, "air_sea_difference": None}}
     assert printed_unset == json.loads(json.dumps(DEFAULT_CONFIG))
     resolve_config(printed)
     with pytest.raises(ValueError, match="no_such_key"):
@@ -44,3 +45,31 @@ def test_mwir_day_config_resolves():
     sc = cfg["scene"]
     assert sc["band"] == "MWIR" and sc["daytime"] > 0 and sc["sun_elevation_deg"] == [3.0, 40.0]
     assert sc["sun_azimuth_deg"] == [-60.0, 60.0] and sc["sun_azimuth_relative_to_yaw"] is True
+
+
+@pytest.mark.parametrize("name", ["sea_lwir", "sea_lwir_clips", "sea_mwir_day"])
+def test_shipped_configs_draw_the_air_from_the_sea(name):
+    """The shipped configs draw T_air − T_sea from [−3, 1] K (the usual air–sea difference over the open
+    sea) instead of an independent air range: over their first 64 items every air temperature is
+    within [−3, 1] K of its sea (an independent [283, 303] K air put 17 % of sea_lwir.toml's 256
+    images more than 10 K from their sea), and the resolved config (config.json) records the key."""
+    import tomllib
+
+    from roughsea_torch.dataset_config import config_sampler
+
+    raw = tomllib.loads((ROOT / "pipelines" / "configs" / f"{name}.toml").read_text())
+    assert "air_temperature" not in raw["scene"] and raw["scene"]["air_sea_difference"] == [-3.0, 1.0]
+    cfg = resolve_config(raw)
+    assert cfg["scene"]["air_sea_difference"] == [-3.0, 1.0] and cfg["scene"]["air_temperature"] is None
+    p = config_sampler(cfg).sample_indexed(cfg["seed"], range(64))
+    d = p["air_temperature"] - p["sea_temperature"]
+    assert float(d.min()) >= -3.0 - 1e-9 and float(d.max()) <= 1.0 + 1e-9
+
+
+def test_air_temperature_and_air_sea_difference_together_are_refused():
+    """Both keys in a config's scene table: a ValueError naming both, before any work; so is a
+    difference that takes the sea's range above the air's 330 K."""
+    with pytest.raises(ValueError, match=r"config: scene\.air_temperature and air_sea_difference"):
+        resolve_config({"scene": {"air_temperature": [283.0, 303.0], "air_sea_difference": [-3.0, 1.0]}})
+    with pytest.raises(ValueError, match=r"config: scene\.air_sea_difference: sea_temperature"):
+        resolve_config({"scene": {"sea_temperature": [300.0, 320.0], "air_sea_difference": [-3.0, 15.0]}})

@@ -159,3 +159,127 @@ def test_platform_phase_is_uniform_over_a_turn():
     assert bool(((ph >= 0) & (ph < 2 * math.pi)).all())
     assert abs(float(ph.mean()) - math.pi) < 0.12
     assert abs(float(ph.var()) - math.pi**2 / 3) < 0.2
+
+
+# ------------------------------------------------------------------------------------------------
+# The air as the sea plus a drawn air-sea difference
+# ------------------------------------------------------------------------------------------------
+# the scene fields drawn before air_sea_difference existed, one uniform each, in this order
+OLD_DRAWN = ("wind_speed", "wind_direction_deg", "sea_temperature", "air_temperature", "altitude_m", "pitch_deg",
+             "roll_deg", "yaw_deg", "hfov_deg")
+ATMS = ("tropical", "subarctic_winter")
+RANGES = dict(wind_speed=(2.0, 12.0), sea_temperature=(285.0, 302.0), altitude_m=(10.0, 60.0), yaw_deg=(-20.0, 20.0))
+
+
+def _recompute(n, seed, air_sea=None):
+    """The draws of SceneSampler(atmospheres=ATMS, texture=True, motion=MOTION, daytime=0.5, **RANGES),
+    recomputed from the generator as its docstring orders them (nine scene uniforms, atmosphere,
+    noise seed, wave seed, time, six motion uniforms and the phase, three day uniforms), the
+    scene fields as low + (high − low) u; ``air_sea``: the air as sea + low + (high − low) u of the
+    air's row."""
+    g = gen(seed)
+    u = torch.rand(len(OLD_DRAWN), n, generator=g, dtype=torch.float64)
+    atm = torch.randint(len(ATMS), (n,), generator=g)
+    noise = torch.randint(0, 2**62, (n,), generator=g)
+    wave = torch.randint(0, 2**62, (n,), generator=g)
+    time_s = 0.0 + (3600.0 - 0.0) * torch.rand(n, generator=g, dtype=torch.float64)
+    um = torch.rand(7, n, generator=g, dtype=torch.float64)
+    us = torch.rand(3, n, generator=g, dtype=torch.float64)
+    defaults = {"wind_direction_deg": (0.0, 360.0), "pitch_deg": (-10.0, -1.0), "roll_deg": (-2.0, 2.0),
+                "hfov_deg": (20.0, 40.0), **RANGES}
+    out = {name: defaults[name][0] + (defaults[name][1] - defaults[name][0]) * u[i]
+           for i, name in enumerate(OLD_DRAWN) if name != "air_temperature"}
+    own = torch.tensor([rs.atmosphere.surface_air_temperature(a) for a in ATMS], dtype=torch.float64)
+    out["air_temperature"] = own[atm] if air_sea is None else out["sea_temperature"] + (
+        air_sea[0] + (air_sea[1] - air_sea[0]) * u[OLD_DRAWN.index("air_temperature")])
+    motion = {"pitch_amplitude_deg": (0.0, 1.0), "roll_amplitude_deg": (0.0, 4.0), "heave_amplitude_m": (0.0, 1.0),
+              "pitch_period_s": (5.0, 12.0), "roll_period_s": (5.0, 12.0), "heave_period_s": (5.0, 12.0)}  # MOTION, defaults
+    out.update({name: lo + (hi - lo) * um[i] for i, (name, (lo, hi)) in enumerate(motion.items())})
+    out.update(atmosphere=atm, noise_seed=noise, wave_seed=wave, time_s=time_s, phase_rad=2.0 * math.pi * um[-1],
+               is_day=us[0] < 0.5, sun_elevation_deg=2.0 + 58.0 * us[1],
+               sun_azimuth_deg=-180.0 + 360.0 * us[2] + out["yaw_deg"])
+    return out, g
+
+
+def test_draws_without_air_sea_difference_are_unchanged():
+    """Without air_sea_difference (left out, or None) every field is what the sampler drew before the
+    option existed, bit for bit: an independent recomputation from the generator in the documented
+    order, with nine scene uniforms (a tenth row, or a draw of the difference anywhere, would shift
+    the atmosphere, seeds, texture, motion and sun), and the generator is left in the same state.
+    With it, only the air changes: the sea plus a difference from the air's own uniform row."""
+    n = 16
+    kw = dict(atmospheres=ATMS, texture=True, motion=MOTION, daytime=0.5, **RANGES)
+    want, g_want = _recompute(n, 31)
+    g_a, g_b = gen(31), gen(31)
+    a = SceneSampler(**kw).sample(n, g_a)
+    b = SceneSampler(air_sea_difference=None, **kw).sample(n, g_b)
+    assert set(a) == set(b) == set(want) | {"air_sea_difference"}
+    for k, v in want.items():
+        assert torch.equal(a[k], v), k
+        assert torch.equal(b[k], v), k
+    after = torch.rand(4, generator=g_want)  # the generator's next draws after the recomputation's
+    assert torch.equal(torch.rand(4, generator=g_a), after) and torch.equal(torch.rand(4, generator=g_b), after)
+    # with the difference: the air is the sea plus it; every other field as without
+    want_d, g_want_d = _recompute(n, 31, air_sea=(-3.0, 1.0))
+    g_c = gen(31)
+    c = SceneSampler(air_sea_difference=(-3.0, 1.0), **kw).sample(n, g_c)
+    for k, v in want_d.items():
+        assert torch.equal(c[k], v), k
+    assert not torch.equal(c["air_temperature"], a["air_temperature"])
+    assert torch.equal(torch.rand(4, generator=g_c), torch.rand(4, generator=g_want_d))
+
+
+def test_air_sea_difference_is_uniform_and_independent_of_the_sea():
+    """air_sea_difference=(−3, 1): every image's T_air − T_sea lies in [−3, 1] K (to rounding), and
+    the record ``air_sea_difference`` is that difference; over 4000 draws the difference is uniform
+    (Kolmogorov–Smirnov statistic below 1.95/√n, the 0.1 % critical value) and uncorrelated with the
+    sea (|r| < 4/√n), and the sea keeps its own uniform range."""
+    from scipy import stats
+
+    n = 4000
+    p = SceneSampler(sea_temperature=(285.0, 302.0), air_sea_difference=(-3.0, 1.0),
+                     atmospheres=["tropical", "us_standard"]).sample(n, gen(17))
+    d = p["air_temperature"] - p["sea_temperature"]
+    assert float(d.min()) >= -3.0 - 1e-9 and float(d.max()) <= 1.0 + 1e-9
+    torch.testing.assert_close(p["air_sea_difference"], d, rtol=0, atol=1e-9)
+    assert stats.kstest(d.numpy(), stats.uniform(loc=-3.0, scale=4.0).cdf).statistic < 1.95 / math.sqrt(n)
+    assert stats.kstest(p["sea_temperature"].numpy(), stats.uniform(loc=285.0, scale=17.0).cdf).statistic < 1.95 / math.sqrt(n)
+    r = float(torch.corrcoef(torch.stack([d, p["sea_temperature"]]))[0, 1])
+    assert abs(r) < 4.0 / math.sqrt(n), r
+    # without it the record is the air the sampler drew (here each atmosphere's own) minus the sea
+    q = SceneSampler(sea_temperature=(285.0, 302.0), atmospheres=["tropical"]).sample(50, gen(1))
+    own = rs.atmosphere.surface_air_temperature("tropical")
+    assert torch.equal(q["air_temperature"], torch.full((50,), own, dtype=torch.float64))
+    torch.testing.assert_close(q["air_sea_difference"], own - q["sea_temperature"], rtol=0, atol=1e-12)
+
+
+def test_a_fixed_air_sea_difference_holds_exactly():
+    """A number holds the difference fixed: T_air = T_sea − 2 K in every image, in the same-on-batch
+    draw too."""
+    s = SceneSampler(sea_temperature=(280.0, 300.0), air_sea_difference=-2.0)
+    for p in (s.sample(20, gen(2)), s.sample(5, gen(2), same_on_batch=True), s.sample_indexed(3, [0, 9])):
+        torch.testing.assert_close(p["air_temperature"], p["sea_temperature"] - 2.0, rtol=0, atol=1e-12)
+        assert torch.equal(p["air_sea_difference"], torch.full_like(p["sea_temperature"], -2.0))
+
+
+@pytest.mark.parametrize(
+    "kwargs, pattern",
+    [
+        (dict(air_temperature=(283.0, 303.0), air_sea_difference=(-3.0, 1.0)), r"air_temperature and air_sea_difference"),
+        (dict(air_temperature=290.0, air_sea_difference=0.0), r"air_temperature and air_sea_difference"),
+        (dict(air_sea_difference=(-31.0, 1.0)), r"air_sea_difference.*\[-30, 30\]"),
+        (dict(air_sea_difference=(1.0, -3.0)), r"air_sea_difference.*inverted"),
+        (dict(air_sea_difference=(0.0, float("nan"))), r"air_sea_difference"),
+        (dict(air_sea_difference="cold"), r"air_sea_difference"),
+        (dict(sea_temperature=(300.0, 320.0), air_sea_difference=(0.0, 20.0)),
+         r"air_sea_difference: sea_temperature \(300, 320\) K.*\[300, 340\] K.*\[230, 330\] K"),
+    ],
+)
+@pytest.mark.parametrize("cls", [SceneSampler, RandomSeaBackground, RandomSeaClip])
+def test_bad_air_sea_difference_raises_naming_it(cls, kwargs, pattern):
+    """Both ways of drawing the air at once, a difference outside [−30, 30] K or not a range, and a
+    sea range plus difference that leaves the air's [230, 330] K: a ValueError naming the arguments."""
+    with pytest.raises(ValueError, match=pattern):
+        cls(**kwargs)
+    assert SceneSampler(sea_temperature=(260.0, 300.0), air_sea_difference=(-30.0, 30.0)).ranges["air_sea_difference"] \
+        == (-30.0, 30.0)  # the edges of both allowed ranges are accepted
