@@ -1,8 +1,8 @@
 """The main job: render a batch of infrared sea backgrounds on the built-in default scene.
 
-Eight 512×640 LWIR (8–12 µm) images, each with its own wind, wind direction, sea temperature and
-camera pose, under the shipped LOWTRAN7 midlatitude-summer sky, each a textured sea realization
-(wave clutter; ``--no-texture`` renders the expectation images, the mean over the slope
+Eight 512×640 LWIR (8–12 µm) images, each with its own wind, wind direction, sea temperature (air − sea
+in [−3, 1] K, the atmosphere's surface air) and camera pose, under the shipped LOWTRAN7
+midlatitude-summer sky, each a textured sea realization (wave clutter; ``--no-texture`` renders the expectation images, the mean over the slope
 statistics). Writes to ``--out``:
 
 - ``grid_brightness_temperature.png``: the batch as a picture grid (brightness temperature, K), one
@@ -32,14 +32,17 @@ import roughsea_torch as rs
 from _common import colour_range, save_grid, save_png16
 
 
-def default_batch(batch: int, seed: int = 0) -> dict[str, torch.Tensor]:
+def default_batch(batch: int, seed: int = 0, air_temperature: float | None = None) -> dict[str, torch.Tensor]:
+    """The batch's parameters; with the atmosphere's surface ``air_temperature`` [K] the sea is drawn
+    within [−1, +3] K of it (air − sea in [−3, 1] K, as over the open sea), else in [285, 300] K."""
     g = torch.Generator().manual_seed(seed)
 
     def u(lo: float, hi: float) -> torch.Tensor:
         return lo + (hi - lo) * torch.rand(batch, generator=g)
 
     return dict(
-        wind_speed=u(1.0, 20.0), wind_direction=u(-3.14159, 3.14159), sea_temperature=u(285.0, 300.0),
+        wind_speed=u(1.0, 20.0), wind_direction=u(-3.14159, 3.14159),
+        sea_temperature=u(285.0, 300.0) if air_temperature is None else air_temperature - u(-3.0, 1.0),
         altitude_m=torch.exp(u(2.3, 6.2)),  # 10 m … 500 m
         pitch_deg=u(-8.0, -1.0), yaw_deg=u(-180.0, 180.0), roll_deg=u(-3.0, 3.0),
     )
@@ -58,13 +61,14 @@ def main() -> None:
                     help="textured sea realizations (default) or expectation images (--no-texture)")
     args = ap.parse_args()
 
-    p = default_batch(args.batch, args.seed)
-    cams = rs.make_camera(args.height, args.width, hfov_deg=args.hfov, altitude_m=p["altitude_m"],
-                          pitch_deg=p["pitch_deg"], yaw_deg=p["yaw_deg"], roll_deg=p["roll_deg"])
     try:
         sky = float(args.sky)  # a constant sky radiance [W m-2 sr-1]
     except ValueError:
         sky = args.sky  # a shipped atmosphere
+    air = rs.atmosphere.surface_air_temperature(sky) if isinstance(sky, str) else None  # [K], the atmosphere's
+    p = default_batch(args.batch, args.seed, air)
+    cams = rs.make_camera(args.height, args.width, hfov_deg=args.hfov, altitude_m=p["altitude_m"],
+                          pitch_deg=p["pitch_deg"], yaw_deg=p["yaw_deg"], roll_deg=p["roll_deg"])
     wave_seeds = [1000 * args.seed + i for i in range(args.batch)] if args.texture else None
     scene = rs.SeaScene(wind_speed=p["wind_speed"], wind_direction=p["wind_direction"],
                         sea_temperature=p["sea_temperature"], sky=sky, seed=wave_seeds)
@@ -85,7 +89,6 @@ def main() -> None:
               note="each panel's colour range from its lower half (1–99 %): the sea's clutter; the sky clips")
     lo, hi = 250.0, 310.0
     res = scene.resolved(args.batch, torch.float32, torch.device("cpu"))
-    air = rs.atmosphere.surface_air_temperature(args.sky) if isinstance(sky, str) else None  # [K], the atmosphere's
     meta = {"roughsea_torch": rs.__version__, "band_m": [8e-6, 12e-6], "sky": args.sky, "path": scene.path is not None,
             "foam": "auto (Monahan's whitecap fraction on the crests)", "earth_radius_m": rs.EARTH_RADIUS_M,
             "table": repr(rs.TableSize()), "image_size": [args.height, args.width], "hfov_deg": args.hfov,
