@@ -2,8 +2,8 @@
 
 Eight 512×640 LWIR (8–12 µm) images, each with its own wind, wind direction, sea temperature (air − sea
 in [−3, 1] K, the atmosphere's surface air) and camera pose, under the shipped LOWTRAN7
-midlatitude-summer sky, each a textured sea realization (wave clutter; ``--no-texture`` renders the expectation images, the mean over the slope
-statistics). Writes to ``--out``:
+midlatitude-summer sky, each a textured sea realization (wave clutter; ``--no-texture`` renders the
+expectation images, the mean over the slope statistics). Writes to ``--out``:
 
 - ``grid_brightness_temperature.png``: the batch as a picture grid (brightness temperature, K), one
   colour range for all;
