@@ -405,6 +405,10 @@ class SeaShardDataset(torch.utils.data.IterableDataset):
         S, N = cfg["shard_size"], cfg["num_images"]
         return sum(min(S, N - int(f[6:12]) * S) for f in self._my_shards(1, 0))
 
+    def __getitem__(self, index: Any) -> Any:
+        raise TypeError("SeaShardDataset streams its shards (an IterableDataset): iterate it (for image, meta in ds) or "
+                        "wrap it in a torch.utils.data.DataLoader; it has no ds[i]")
+
     def _my_shards(self, nworkers: int, worker: int) -> list[str]:
         rank, world = self.rank, self.world_size
         if rank is None or world is None:

@@ -111,6 +111,8 @@ def test_metadata_reproduces_each_image(reference):
     sensor = build_sensor(cfg)
     ds = list(SeaShardDataset(reference))
     assert [m["index"] for _, m in ds] == list(range(7))
+    with pytest.raises(TypeError, match="iterate"):  # a stream: ds[i] says so (it was torch's bare NotImplementedError)
+        SeaShardDataset(reference)[0]
     atmospheres = ("tropical", "us_standard")
     textured = []
     for img, meta in ds[:3]:
