@@ -20,6 +20,7 @@ m s⁻¹ at 12.5 m, times and periods in s, frame rate in Hz.
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any, Sequence
 
 import torch
@@ -269,6 +270,11 @@ class SceneSampler:
             value = ranges.get(name, default)
             self.ranges[name] = None if value is None else as_range(name, value, allowed, unit)
         self._check_air_sea_difference()
+        pitch_lo, hfov_hi = self.ranges["pitch_deg"][0], self.ranges["hfov_deg"][1]
+        if pitch_lo >= 0.5 * hfov_hi:
+            warnings.warn(f"pitch_deg: every draw looks up by at least {pitch_lo:g}°, half the widest field of view or more "
+                          f"(hfov_deg up to {hfov_hi:g}°): an image no taller than wide then holds no sea, only sky; "
+                          "negative pitches look down at the sea", UserWarning, stacklevel=2)
         self.path = path
         self.texture = texture
         self.time_s = as_range("time_s", time_s, TIME_RANGE_S, "s")

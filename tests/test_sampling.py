@@ -5,6 +5,7 @@ that turning them on changes no other draw), and the checks of every range."""
 from __future__ import annotations
 
 import math
+import warnings
 
 import pytest
 import torch
@@ -283,3 +284,17 @@ def test_bad_air_sea_difference_raises_naming_it(cls, kwargs, pattern):
         cls(**kwargs)
     assert SceneSampler(sea_temperature=(260.0, 300.0), air_sea_difference=(-30.0, 30.0)).ranges["air_sea_difference"] \
         == (-30.0, 30.0)  # the edges of both allowed ranges are accepted
+
+
+def test_a_pose_range_above_the_horizon_warns():
+    """Draws whose lowest pitch is half the widest field of view or more look only at the sky (a landscape
+    image's lower edge is then above the horizon): a new user's "sea backgrounds" came out sky-only without
+    a word. The rendered image confirms it; a range that reaches below the horizon does not warn."""
+    with pytest.warns(UserWarning, match="pitch_deg"):
+        s = SceneSampler(pitch_deg=(12.0, 20.0), hfov_deg=(16.0, 24.0), roll_deg=0.0, path=False)
+    p = s.sample(1, torch.Generator().manual_seed(0))
+    cams = rs.make_camera(12, 16, hfov_deg=float(p["hfov_deg"][0]), pitch_deg=float(p["pitch_deg"][0]), altitude_m=20.0)
+    assert not bool(rs.view_geometry(cams).is_sea.any())  # no pixel sees the sea
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        SceneSampler(pitch_deg=(-2.0, 20.0), hfov_deg=(16.0, 24.0), path=False)
