@@ -72,10 +72,11 @@ def second_moments(a: np.ndarray, b: np.ndarray, same: bool, noise: np.ndarray |
     are independent and no correction is needed."""
     x, y = tvr.clutter(a), tvr.clutter(b)
     c0 = float((x * y).mean())
-    if same and noise is not None:
-        c0 -= float(noise.mean()) * (1.0 - 1.0 / x.shape[1])
     across = 0.5 * float((x[:, 1:] * y[:, :-1]).mean() + (x[:, :-1] * y[:, 1:]).mean())
     along = 0.5 * float((x[1:] * y[:-1]).mean() + (x[:-1] * y[1:]).mean())
+    if same and noise is not None:  # removing a row's mean leaves its white noise −σ²/W correlated across
+        c0 -= float(noise.mean()) * (1.0 - 1.0 / x.shape[1])
+        across += float(noise.mean()) / x.shape[1]
     return dict(c0=c0, across=across, along=along)
 
 
