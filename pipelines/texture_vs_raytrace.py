@@ -133,6 +133,7 @@ def retexture(saved: dict) -> tuple[list[dict], list[dict]]:
             bins.append(dict(b, sigma_tex=sigma(a), ratio=sigma(a) / b["sigma_ray"] if m else math.nan,
                              r_pix=correlation(a, r, nz) if m else math.nan,
                              r_block=block_correlation(a, r, nz) if m else math.nan, len_tex=correlation_length(a),
+                             len_ray=correlation_length(r, nz) if m else math.nan,
                              mean_diff=float((a - r).mean()),
                              hidden_warm=float((a - r)[hid].mean()) if hid.any() else math.nan))
         cases.append(dict(c, tex=tex, bins=bins,
@@ -209,10 +210,11 @@ def correlation_length(img: np.ndarray, noise: np.ndarray | None = None) -> floa
     """Lag [px] at which the row-wise autocorrelation of the clutter falls to 1/e (linear between lags);
     inf if it does not within half the width."""
     x = clutter(img)
-    c0 = (x**2).mean() - (0.0 if noise is None else noise.mean() * (1 - 1 / x.shape[1]))
+    n = 0.0 if noise is None else float(noise.mean())
+    c0 = (x**2).mean() - n * (1 - 1 / x.shape[1])
     prev = 1.0
-    for lag in range(1, x.shape[1] // 2):
-        rho = (x[:, :-lag] * x[:, lag:]).mean() / c0
+    for lag in range(1, x.shape[1] // 2):  # (removing the row mean leaves white noise correlated −n/W at every lag)
+        rho = ((x[:, :-lag] * x[:, lag:]).mean() + n / x.shape[1]) / c0
         if rho < 1 / math.e:
             return lag - 1 + (prev - 1 / math.e) / (prev - rho)
         prev = rho
