@@ -43,7 +43,6 @@ import math
 import os
 import sys
 import time
-import warnings
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -104,13 +103,15 @@ def trace(cams, wind: float, direction: float, seed: int, time_s: float, rays: i
 
 
 def textured(cams, wind: float, direction: float, seed: int, time_s: float, shadowing) -> np.ndarray:
+    """The first-hit textured render (``texture_vs_raytrace.render``) of the traced realization [K]."""
     scene = rs.SeaScene(wind_speed=wind, wind_direction=direction, sea_temperature=tvr.T_SEA, seed=seed, time_s=time_s,
                         foam=False, path=False, shadowing=shadowing)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)
-        img = rs.render(cams, scene, output="brightness_temperature", earth_radius_m=math.inf,
-                        table=rs.TableSize(texture_hit="first"))
-    return img[0, 0].double().numpy()
+    return tvr.render(cams, scene, table=rs.TableSize(texture_hit="first"))[0, 0].numpy()
+
+
+def masking(option: str) -> bool | str:
+    """``--shadowing`` as ``SeaScene(shadowing=)`` and ``raytraced_image(shadowing=)`` take it."""
+    return True if option == "eq5" else option
 
 
 def run_case(direction_name: str, wind: float, args) -> dict:
@@ -119,9 +120,9 @@ def run_case(direction_name: str, wind: float, args) -> dict:
     vz = np.degrees(rs.view_geometry(cams, earth_radius_m=math.inf).view_zenith[0].double().numpy())
     traces = {}
     for i, k in enumerate(K_LIST):
-        traces[k] = trace(cams, wind, direction, args.seed, args.time, args.rays, k, None, i + 1, args.shadowing)
+        traces[k] = trace(cams, wind, direction, args.seed, args.time, args.rays, k, None, i + 1, masking(args.shadowing))
     traces["split"] = trace(cams, wind, direction, args.seed, args.time, args.rays, 64.0, 4.0, len(K_LIST) + 1,
-                            args.shadowing)
+                            masking(args.shadowing))
     tex = {name: textured(cams, wind, direction, args.seed, args.time, sh)
            for name, sh in (("multiscale", "multiscale"), ("eq5", True))}
     bins = []
@@ -153,8 +154,8 @@ def pixel_scaling(direction_name: str, wind: float, args) -> dict:
         vz = np.degrees(rs.view_geometry(cams, earth_radius_m=math.inf).view_zenith[0, :, tvr.W // 2].double().numpy())
         d, t4 = [], []
         for ray_seed in (1, 2):
-            full = trace(cams, wind, direction, args.seed, args.time, args.rays, 64.0, None, ray_seed, args.shadowing)
-            low = trace(cams, wind, direction, args.seed, args.time, args.rays, 64.0, 4.0, ray_seed, args.shadowing)
+            full = trace(cams, wind, direction, args.seed, args.time, args.rays, 64.0, None, ray_seed, masking(args.shadowing))
+            low = trace(cams, wind, direction, args.seed, args.time, args.rays, 64.0, 4.0, ray_seed, masking(args.shadowing))
             d.append(full["T"] - low["T"])
             t4.append(low["T"])
         for lo, hi in VZ_BINS:
@@ -268,9 +269,6 @@ def main() -> None:
     ap.add_argument("--out", default="docs")
     args = ap.parse_args()
     torch.set_num_threads(1)
-    shadowing = True if args.shadowing == "eq5" else args.shadowing
-    args_shadowing = args.shadowing
-    args.shadowing = shadowing
     t0 = time.perf_counter()
     cases = []
     for spec in args.cases:
@@ -279,7 +277,6 @@ def main() -> None:
             raise ValueError(f"--cases: direction must be one of {sorted(tvr.DIRECTIONS)}; got {d!r}")
         print(f"{d} {w} m/s ...", flush=True)
         cases.append(pixel_scaling(d, float(w), args) if args.pixel_scaling else run_case(d, float(w), args))
-    args.shadowing = args_shadowing
     if args.pixel_scaling:
         write_report(args.out, "clutter_octaves_pixels.md", scaling_report(cases, args, time.perf_counter() - t0))
         return

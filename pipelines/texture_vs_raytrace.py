@@ -110,10 +110,12 @@ def selected(case: dict, patterns: list[str]) -> bool:
     return False
 
 
-def render(cams, sc) -> torch.Tensor:
+def render(cams, sc, table: rs.TableSize | None = None) -> torch.Tensor:
+    """Brightness temperature [K] (float64) on a flat Earth, with ``table`` (default ``TABLE``)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # the README's "resolved slopes scaled down" note
-        return rs.render(cams, sc, output="brightness_temperature", earth_radius_m=INF, table=TABLE).double()
+        return rs.render(cams, sc, output="brightness_temperature", earth_radius_m=INF,
+                         table=TABLE if table is None else table).double()
 
 
 def retexture(saved: dict) -> tuple[list[dict], list[dict]]:

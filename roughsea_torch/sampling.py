@@ -81,8 +81,8 @@ TIME_RANGE_S = (0.0, 86400.0)  # allowed range of the realizations' times [s]
 DEFAULT_TIME_S = (0.0, 3600.0)  # default range of the realizations' times [s]
 SCENE_FIELD_NAMES = tuple(f[0] for f in SCENE_FIELDS)  # the names alone, in the order of the draws
 # the scene fields a render uses: all but air_sea_difference, which a draw holds as a record (T_air − T_sea)
+# (also the fields drawn, one uniform each in this order: the difference takes the air's)
 RENDER_FIELD_NAMES = tuple(n for n in SCENE_FIELD_NAMES if n != "air_sea_difference")
-_DRAWN_FIELD_NAMES = RENDER_FIELD_NAMES  # one uniform each, in this order (the difference uses the air's)
 MOTION_FIELD_NAMES = tuple(f[0] for f in MOTION_FIELDS)
 _MIX = 0x9E3779B97F4A7C15  # golden-ratio constant of splitmix64
 _MASK = (1 << 64) - 1
@@ -356,14 +356,14 @@ class SceneSampler:
         if generator is not None and generator.device.type != "cpu":
             raise ValueError("generator must be a CPU torch.Generator (parameters are drawn on the CPU, then moved)")
         n = 1 if same_on_batch else batch_size
-        u = torch.rand(len(_DRAWN_FIELD_NAMES), n, generator=generator, dtype=torch.float64)
+        u = torch.rand(len(RENDER_FIELD_NAMES), n, generator=generator, dtype=torch.float64)
         atm = torch.randint(len(self.atmospheres), (n,), generator=generator)
         seeds = torch.randint(0, 2**62, (n,), generator=generator)
         # T_air - T_sea, when given, from the uniform an air range would take (drawn either way)
         diff_range = self.ranges["air_sea_difference"]
-        diff = None if diff_range is None else _uniform(diff_range, u[_DRAWN_FIELD_NAMES.index("air_temperature")])
+        diff = None if diff_range is None else _uniform(diff_range, u[RENDER_FIELD_NAMES.index("air_temperature")])
         out: dict[str, torch.Tensor] = {}
-        for i, name in enumerate(_DRAWN_FIELD_NAMES):
+        for i, name in enumerate(RENDER_FIELD_NAMES):
             r = self.ranges[name]
             if r is not None:
                 out[name] = _uniform(r, u[i])
