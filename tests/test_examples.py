@@ -40,7 +40,8 @@ def test_main_job_metadata_holds_what_made_each_image(tmp_path):
     """The README's main job (examples/render_default.py, run small): metadata.json holds, per image,
     the air temperature (the atmosphere's surface air, from the LOWTRAN tables), the whitecap fraction
     (Monahan's law at the image's wind) and its wave seed, and for the run the package version and
-    the table settings (they were missing: a new user's finding)."""
+    the table settings (they were missing: a new user's finding); the sea within [−1, 3] K of that air (it was
+    drawn in 285–300 K whatever the air)."""
     import json
     import subprocess
 
@@ -50,6 +51,7 @@ def test_main_job_metadata_holds_what_made_each_image(tmp_path):
     assert meta["roughsea_torch"] == rs.__version__ and "texture_antialias" in meta["table"]
     for img in meta["images"]:
         assert img["air_temperature"] == rs.atmosphere.surface_air_temperature("midlatitude_summer")
+        assert -3.0 <= img["air_temperature"] - img["sea_temperature"] <= 1.0  # as over the open sea
         w = float(rs.foam.whitecap_fraction(torch.tensor(img["wind_speed"], dtype=torch.float64)))
         assert abs(img["whitecap_fraction"] - w) < 1e-6 * max(w, 1e-6)
         assert isinstance(img["wave_seed"], int)

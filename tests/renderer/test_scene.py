@@ -370,6 +370,8 @@ def test_batch_mismatch_names_the_argument():
     cams = rs.make_camera(8, 8, batch_size=2)
     with pytest.raises(ValueError, match=r"seed has batch size 3 .* the cameras have 2 images"):
         rs.render(cams, rs.SeaScene(wind_speed=5.0, sea_temperature=290.0, seed=[1, 2, 3]))
+    with pytest.raises(ValueError, match=r"the cameras have 1 image;"):  # (it said "1 images")
+        rs.render(rs.make_camera(8, 8), rs.SeaScene(wind_speed=torch.tensor([5.0, 6.0]), sea_temperature=290.0))
     with pytest.raises(ValueError, match=r"seed: a sequence of seeds needs one per image, B = 2; got 3"):
         rs.SeaScene(wind_speed=torch.tensor([5.0, 6.0]), sea_temperature=290.0, seed=[1, 2, 3]).batch_size
     with pytest.raises(ValueError, match=r"wind_speed has 2, sea_temperature has 3"):
