@@ -14,7 +14,8 @@ import torch
 import roughsea_torch as rs
 from roughsea_torch.renderer.antialias import FOAM_TAPS, filter_columns
 from roughsea_torch.clutter import along_view, footprint, two_scale_statistics
-from roughsea_torch.renderer.texture import TextureTable, _across_quantile
+from roughsea_torch.renderer.swept import _across_quantile
+from roughsea_torch.renderer.texture import TextureTable
 from roughsea_torch.whitecaps import whitecap_cover
 
 from conftest import horizon_sky, make_cams, make_scene, torch_threads

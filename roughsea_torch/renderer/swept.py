@@ -1,0 +1,202 @@
+"""The first-hit texture of a textured render (``TableSize(texture_hit="first")``): per image, the
+sweep of the resolved surface along ground tracks (:mod:`~roughsea_torch.renderer.hits`), the texture
+and foam at its visible samples, and each pixel's average over the visible surface of its window. A
+mixin of :class:`~roughsea_torch.renderer.texture.TextureTable`, whose volume, scene and settings it
+uses; the physics and its measurements: ``docs/texture.md`` §11.
+
+Sources: as :mod:`~roughsea_torch.renderer.hits` (the running-horizon column sweep of height-field
+renderers; the two-scale split of Bruneton, Neyret & Holzschuch 2010).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import torch
+
+from .._parallel import BLOCK, in_blocks
+from ..clutter import footprint, resolved_quantile, view_moments
+from ..geometry import slant_range
+from ..whitecaps import whitecap_cover
+from .hits import (Sweep, covers, flat_nonzero, footprint_fade, nonzero_2d, pixel_hits, pixel_windows, read_at,
+                   sweep_envelope, sweep_layout, track_windows, visible_samples)
+
+__all__ = ["SweptTexture"]
+
+
+class SweptTexture:
+    """The sweep's part of :class:`~roughsea_torch.renderer.texture.TextureTable` (``texture_hit="first"``):
+    its :meth:`_pixels_swept` is what ``TextureTable.pixels`` returns with the first hit. It reads the
+    table's fields (the scene and its parameters, the camera's δ and centres, the times, the sweep's
+    settings) and its volume (``_read_volume``)."""
+
+    def _pixels_swept(self, sl: slice, vol: torch.Tensor, cos_t: torch.Tensor, dz: torch.Tensor, dx: torch.Tensor,
+                      dy: torch.Tensor, sea: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor,
+                      b: torch.Tensor, coordinate: Any, crest: bool) -> tuple:
+        """:meth:`pixels` by the sweep: per image, the resolved surface along ground tracks, the texture
+        and foam fraction at each sample, each pixel's angular average over the visible surface of its
+        window; for the glint, x and the covariance at its centre ray's first hit. The texture, the
+        resolved covariance and the foam covers fade out with the pixel's own footprint
+        (:func:`footprint_fade` g: the texture g · the sweep's, the covariance g² · the hit's, the covers
+        g · the sweep's + (1 − g) · the flat point's), so where the pixel resolves no band it is the flat
+        point's, i.e. the expectation image."""
+        zero = torch.zeros_like(dz)
+        texture, x_c, f_pix = zero.clone(), zero.clone(), (zero.clone(), zero.clone()) if crest else None
+        cov_c = [zero.clone() for _ in range(3)]
+        h = self.altitude[sl].to(self.dtype)
+        for i in range(dz.shape[0]):
+            s = sea[i]
+            if not bool(s.any()):
+                continue
+            im = sl.start + i
+            wf = self.field(slice(im, im + 1))
+            R = slant_range(cos_t[i][s], h[i], self.earth_radius_m)
+            L = footprint(R, cos_t[i][s], self.ifov[im])
+            g = footprint_fade(wf, 0, L)
+            rho = torch.sqrt(dx[i] * dx[i] + dy[i] * dy[i]).clamp_min(1e-30)
+            tan_g, phi = (-dz[i] / rho)[s], torch.atan2(dy[i], dx[i])[s]
+            sw = None
+            if bool((g.detach() > 0).any()):  # (else no pixel resolves a band: the expectation image)
+                sw = sweep_layout(wf, 0, self.centres[im], self.altitude[im], tan_g, phi, float(self.ifov[im]),
+                                  self.earth_radius_m, tracks=self.hit_tracks, **self.hit_layout)
+            if sw is None:
+                g = torch.zeros_like(g)
+            flat = self._flat_covers(im, wf, R, L, dx[i][s], dy[i][s], g) if crest else None
+            if crest:
+                for c in range(2):
+                    f_pix[c][i] = f_pix[c][i].index_put((s,), flat[c])
+            if sw is None:
+                continue
+            tau_t, tau_b = pixel_windows(tan_g, float(self.ifov[im]))
+            j = ((phi.detach() - sw.p0) / sw.dphi).round().clamp(0, sw.az.shape[0] - 1).long()
+            sw, m = self._swept_envelope(im, wf, sw, j, tau_t, g)
+            on = flat_nonzero(g.detach() > 0)  # (the pixels that take the sweep's texture)
+            window = track_windows(sw.shape[1], j.index_select(0, on), tau_t.index_select(0, on), tau_b.index_select(0, on))
+            values, x_k, cov_k = self._swept_samples(im, i, wf, sw, m, window, vol, lo, span_z, a, b, coordinate, crest)
+            avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g, overwrite=True)
+            texture[i] = texture[i].index_put((s,), g * avg[0])
+            if crest:  # the active and residual covers
+                for c in range(2):
+                    f_pix[c][i] = f_pix[c][i].index_put((s,), flat[c] + g * avg[1 + c])
+            # (x = 0 where g = 0: the pixel resolves nothing, its resolved covariance g² C is 0 too)
+            x_c[i] = x_c[i].index_put((s,), torch.where(hit & (g.detach() > 0), read_at(*x_k, k * sw.shape[1] + j),
+                                                         torch.zeros_like(tan_g)))
+            for c in range(3):  # (g² C: the glint's resolved part fades with the texture)
+                cov_c[c][i] = cov_c[c][i].index_put((s,), g * g * cov_k[c][k])
+        return texture, (x_c, x_c), tuple(cov_c), f_pix
+
+    def _flat_covers(self, im: int, wf: Any, R: torch.Tensor, L: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor,
+                     g: torch.Tensor) -> list[torch.Tensor]:
+        """(1 − g) · the foam covers (f_act, f_res) of pixels of image ``im`` at their flat-sea points, as
+        :meth:`pixels` takes them with ``texture_hit="flat"`` (without its column filter), each (P,):
+        slant ranges ``R``, footprints ``L``, ray directions ``dx``, ``dy`` and the sweep's weights ``g``
+        (P,); evaluated only where g < 1."""
+        out = [torch.zeros_like(g), torch.zeros_like(g)]
+        need = flat_nonzero(g.detach() < 1.0)
+        if need.numel() == 0:
+            return out
+        pick = lambda v: v.index_select(0, need)  # noqa: E731
+        Rn, Ln, t_s = pick(R), pick(L)[None], self.time[im:im + 1]
+        X = (self.centres[im, 0] + Rn * pick(dx))[None]
+        Y = (self.centres[im, 1] + Rn * pick(dy))[None]
+        crest = wf.sample_unchecked(X, Y, t_s, Ln, elevation=False, crest=True, slopes=False)["crest"]
+        covers = whitecap_cover(wf, X, Y, t_s, Ln, crest, wf.crest_variance(Ln), wf.crest_variance()[:, None],
+                                self.p.foam[im:im + 1].to(self.dtype)[:, None], trails=self.foam_trails)
+        w = 1.0 - pick(g)
+        return [o.index_put((need,), w * f[0]) for o, f in zip(out, covers)]
+
+    def _swept_envelope(self, im: int, wf: Any, sw: Sweep, j: torch.Tensor, tau_top: torch.Tensor,
+                        g: torch.Tensor) -> tuple[Sweep, torch.Tensor]:
+        """(the sweep, its running minimum m (nt, ns)) of image ``im``: the elevation read at every sample
+        up to the last that a pixel taking the sweep's texture (g > 0) can see (:meth:`Sweep.until` the
+        least upper edge ``tau_top`` of their windows; the rows beyond, where g = 0, are the expectation
+        image), the whole sweep where that prefix would not reach some window's edge (:func:`covers`:
+        an elevation beyond the sweep's bound η_max)."""
+        def envelope(cand: Sweep) -> torch.Tensor:
+            ns, nt = cand.shape
+            fp = cand.footprint[:, None].expand(ns, nt).reshape(1, -1)
+            eta = wf.sample_unchecked(cand.x.reshape(1, -1), cand.y.reshape(1, -1), self.time[im:im + 1], fp,
+                                      elevation=True, crest=False, slopes=False)["elevation"]
+            return sweep_envelope(cand, eta[0].reshape(ns, nt))[1]
+
+        on = flat_nonzero(g.detach() > 0)
+        jo, to = j.index_select(0, on), tau_top.index_select(0, on)
+        short = sw.until(float(to.min()))
+        if short is not sw:
+            m = envelope(short)
+            if covers(m, jo, to):
+                return short, m
+        return sw, envelope(sw)
+
+    def _swept_samples(self, im: int, i: int, wf: Any, sw: Sweep, m: torch.Tensor, window: tuple, vol: torch.Tensor,
+                       lo: torch.Tensor, span_z: torch.Tensor, a: torch.Tensor, b: torch.Tensor, coordinate: Any,
+                       crest: bool) -> tuple:
+        """At the sweep's samples of image ``im`` (chunk index ``i``), given its running minimum m (nt, ns)
+        (:meth:`_swept_envelope`): the texture and foam fraction (C, nt, ns), the resolved quantiles x and
+        the resolved covariance (3 of (ns,)). The slopes, the crest variable, the texture and the foam are
+        read only at the visible samples within the depressions ``window`` = (lo, hi) (nt,) that the
+        track's pixels see (:func:`visible_samples`: near grazing about half the samples are hidden, and
+        the sweep starts where the steepest ray might meet a crest of η_max, before the windows), 0
+        elsewhere; their per-point work in blocks (:func:`~roughsea_torch._parallel.in_blocks`). The
+        quantiles x come as (the read samples' flat indices, sample-major (ns, nt), ascending; x at each),
+        for :func:`~roughsea_torch.renderer.hits.read_at`."""
+        dtype = self.dtype
+        ns, nt = sw.shape
+        fpk = sw.footprint / self.hit_visibility  # (ns,) the node values' footprint F_s
+        X, Y, t_s = sw.x.reshape(1, -1), sw.y.reshape(1, -1), self.time[im:im + 1]
+        # the samples read, sample-major (ns, nt)
+        sel, row, col = nonzero_2d(visible_samples(m.T, dim=0, window=(window[0][None, :], window[1][None, :])))
+        pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731  (faster than v[idx] on CPU)
+        Xv, Yv, fv = pick(X, sel)[None], pick(Y, sel)[None], pick(fpk, row)[None]
+        smp = wf.sample_unchecked(Xv, Yv, t_s, fv, elevation=False, crest=crest)
+        cov_k = tuple(c[0] for c in wf.resolved_covariance(fpk[None]))  # 3 of (ns,)
+        cx, sx = torch.cos(sw.az), torch.sin(sw.az)  # the tracks' ray directions (camera → sea)
+        # each sample's row in the volume: ζ of its flat view zenith (the local vertical tilts by r/R)
+        t0 = sw.flat_depression()
+        cos_k = torch.sin(torch.atan(t0) + 2.0 * sw.curv * sw.r).clamp(1e-9, 1.0)
+        zeta_k = torch.asinh(cos_k.double() / self.eps[im]).to(dtype)
+        gy_k = (2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez)
+        o_t = coordinate(cx[None, None, :], sx[None, None, :], i)
+
+        def block(u: int, e: int) -> tuple:  # the texture and x at the read samples u:e
+            r_, c_, s_x, s_y = row[u:e], col[u:e], smp["slope_x"][0, u:e], smp["slope_y"][0, u:e]
+            cov_v, cx_v, sx_v = tuple(pick(c, r_) for c in cov_k), pick(cx, c_), pick(sx, c_)
+            x_v = resolved_quantile(s_x, s_y, cov_v, cx_v, sx_v)
+            read = self._read_volume(vol[i:i + 1], x_v[None, None], pick(o_t, c_)[None, None], pick(gy_k, r_)[None, None],
+                                     a[i:i + 1], b[i:i + 1])[0, :, 0]  # (C, e − u)
+            if not self.cross:
+                return read[0], x_v
+            # + g y + h (y² − 1), y the across-view residual of the resolved slope over its rms
+            y = _across_quantile(s_x, s_y, cov_v, cx_v, sx_v, x_v)
+            return read[0] + read[-2] * y + read[-1] * (y * y - 1.0), x_v
+
+        grad = torch.is_grad_enabled() and any(v.requires_grad for v in (vol, smp["slope_x"], cov_k[0], gy_k, o_t, a, b))
+        tex, x_v = in_blocks(block, sel.numel(), max(sel.numel(), 1) if grad else BLOCK)  # (whole with a graph)
+        values = [tex]
+        if crest:
+            var_r = pick(wf.crest_variance(fpk[None]), row)[None]
+            f_act, f_res = whitecap_cover(wf, Xv, Yv, t_s, fv, smp["crest"], var_r, wf.crest_variance()[:, None],
+                                          self.p.foam[im:im + 1].to(dtype)[:, None], trails=self.foam_trails)
+            values += [f_act[0], f_res[0]]
+        # back to every sample (0 at the hidden ones), in the (nt, ns) layout of the envelope, row by row
+        full, at = x_v.new_zeros(len(values), nt * ns), (col * ns).add_(row)
+        for c, v in enumerate(values):
+            full[c].index_copy_(0, at, v)
+        return full.reshape(-1, nt, ns), (sel, x_v), cov_k
+
+
+def _across_quantile(slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple, dx: torch.Tensor, dy: torch.Tensor,
+                     x: torch.Tensor) -> torch.Tensor:
+    """y = c_r/σ_r: the resolved slope's component across the line of sight (ê⊥ = ê turned +90°, ê = −(dx,
+    dy) the unit horizontal direction towards the sensor) less its regression κ_r a on the along-view
+    slope a = x σ_a, over the residual's rms σ_r; clamped to ±3.5 (the quadratic in y is fitted at ±√3); 0
+    where σ_r² ≤ 1e-12 σ_a² (nothing resolved across)."""
+    ex, ey = -dx, -dy
+    var_a, cov_ap, var_p = view_moments(cov, ex, ey)
+    ok_a = var_a > 1e-30
+    inv_a = torch.where(ok_a, var_a, torch.ones_like(var_a)).reciprocal()
+    var_r = var_p - cov_ap * cov_ap * inv_a
+    ok = ok_a & (var_r > 1e-12 * (var_a + var_p))
+    c_r = slope_y * ex - slope_x * ey - cov_ap * x * inv_a.sqrt()
+    y = c_r * torch.rsqrt(torch.where(ok, var_r, torch.ones_like(var_r)))
+    return torch.where(ok, y.clamp(-3.5, 3.5), torch.zeros_like(y))
