@@ -357,6 +357,16 @@ class WaveField:
             raise ValueError(f"footprint must lie in [0, inf] m and not be NaN; got {bad!r}")
         return f
 
+    def slope_tiles(self, time_s: torch.Tensor) -> torch.Tensor:
+        """The slopes of every band on its own tile at times ``time_s`` ((B,) float64 [s], checked by the
+        caller), (n_bands, B, 2, N, N): (s_x, s_y) world frame, dimensionless, at texel (row i, column j) =
+        (y, x) = (i, j) · L_o / N of band o's period L_o (``bands.tile_length``); what :meth:`sample` reads
+        bilinearly at full band weight. For filtering a band's slopes on its periodic tile (the renderer's
+        patch moments, :mod:`roughsea_torch.renderer.lean`)."""
+        tiles = self._tiles(time_s, elevation=False)
+        n = tiles.shape[-1] - 1
+        return tiles[..., :n, :n]
+
     def _tiles(self, time_s: torch.Tensor, elevation: bool, crest: bool = False, slopes: bool = True) -> torch.Tensor:
         """Band tiles at the given times, (n_bands, B, C, N+1, N+1); C = (η,) (s_x, s_y) (, X)."""
         tiles = []

@@ -109,6 +109,15 @@ class TableSize:
             through y = ±√3 whose mean over y ~ N(0, 1) is the along-view node value (three-point
             Gauss–Hermite), so the ensemble mean stays the along-view texture's; two more evaluations
             per node. False: statistical, as with ``"flat"``.
+        texture_hit_lean, texture_hit_lean_across: with ``texture_hit="first"``, the unresolved waves'
+            own slopes at each sweep sample (default False): their mean and covariance over the sample's
+            patch (``texture_hit_lean_across`` · R δ across the view × the sample's length along it, taken
+            isotropic with that area; :mod:`~roughsea_torch.renderer.lean`), the mean added to the
+            resolved slope where the texture is read, the covariance's along-view variance scaling the
+            unresolved Gaussian's (two more evaluations per node: a quadratic in the log of that scale
+            through ×½ and ×2). Near grazing at light wind a pixel holds few patches of the waves
+            shorter than the samples' footprint, and their realization carries clutter an expectation
+            over them does not (``docs/subpixel_clutter.md``).
         texture_antialias: True (default): the flat-point texture and crest-foam fraction are
             low-pass filtered along the image's columns, with a zero at the rows' Nyquist frequency
             (:mod:`~roughsea_torch.renderer.antialias`: the resolved band there would fold into
@@ -168,6 +177,8 @@ class TableSize:
     texture_hit_tracks: float = 1.0
     texture_hit_visibility: float = 1.0
     texture_hit_cross: bool = True
+    texture_hit_lean: bool = False
+    texture_hit_lean_across: float = 0.7
     texture_azimuth_sun: int = 9
     zenith_narrow: int = 21
     azimuth_day: int = 25
@@ -202,13 +213,14 @@ class TableSize:
         for name, lo, hi in (("texture_steep_zenith_deg", 0.0, 90.0), ("texture_quadrature_width", 1.0, 40.0),
                              ("texture_hit_step", 0.01, 1.0), ("texture_hit_min_step", 0.001, 1.0),
                              ("texture_hit_across", 0.1, 100.0), ("texture_hit_tracks", 0.25, 16.0),
-                             ("texture_hit_visibility", 0.125, 1.0)):
+                             ("texture_hit_visibility", 0.125, 1.0), ("texture_hit_lean_across", 0.05, 4.0)):
             v = getattr(self, name)
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real) or not lo <= float(v) <= hi:
                 raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")
             object.__setattr__(self, name, float(v))
-        if not isinstance(self.texture_hit_cross, (bool, np.bool_)):
-            raise ValueError(f"TableSize.texture_hit_cross must be a bool; got {self.texture_hit_cross!r}")
+        for name in ("texture_hit_cross", "texture_hit_lean"):
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise ValueError(f"TableSize.{name} must be a bool; got {getattr(self, name)!r}")
         if not isinstance(self.foam_trails, (bool, np.bool_)):
             raise ValueError(f"TableSize.foam_trails must be a bool; got {self.foam_trails!r}")
         if not isinstance(self.glitter, (bool, np.bool_)):

@@ -1,25 +1,29 @@
 """The first-hit texture of a textured render (``TableSize(texture_hit="first")``): per image, the
-sweep of the resolved surface along ground tracks (:mod:`~roughsea_torch.renderer.hits`), the texture
-and foam at its visible samples, and each pixel's average over the visible surface of its window. A
-mixin of :class:`~roughsea_torch.renderer.texture.TextureTable`, whose volume, scene and settings it
-uses; the physics and its measurements: ``docs/texture.md`` §11.
+sweep of the resolved surface along ground tracks (:mod:`~roughsea_torch.renderer.hits`), the texture,
+foam and (with ``texture_hit_lean``) the unresolved waves' patch moments at its visible samples
+(:mod:`~roughsea_torch.renderer.lean`), and each pixel's average over the visible surface of its
+window. A mixin of :class:`~roughsea_torch.renderer.texture.TextureTable`, whose volume, scene and
+settings it uses; the physics and its measurements: ``docs/texture.md`` §11.
 
 Sources: as :mod:`~roughsea_torch.renderer.hits` (the running-horizon column sweep of height-field
-renderers; the two-scale split of Bruneton, Neyret & Holzschuch 2010).
+renderers; the two-scale split of Bruneton, Neyret & Holzschuch 2010) and
+:mod:`~roughsea_torch.renderer.lean` (LEAN mapping, Olano & Baker 2010).
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import torch
 
 from .._parallel import BLOCK, in_blocks
-from ..clutter import footprint, resolved_quantile, view_moments
+from ..clutter import footprint, reconcile_scale, resolved_quantile, view_moments
 from ..geometry import slant_range
 from ..whitecaps import whitecap_cover
 from .hits import (Sweep, covers, flat_nonzero, footprint_fade, nonzero_2d, pixel_hits, pixel_windows, read_at,
                    sweep_envelope, sweep_layout, track_windows, visible_samples)
+from .lean import ELL_CLAMP, ShortWaveMoments, projected_area
 
 __all__ = ["SweptTexture"]
 
@@ -74,7 +78,12 @@ class SweptTexture:
             window = track_windows(sw.shape[1], j.index_select(0, on), tau_t.index_select(0, on), tau_b.index_select(0, on))
             values, x_k, cov_k = self._swept_samples(im, i, wf, sw, m, window, vol, lo, span_z, a, b, coordinate, crest)
             avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g, overwrite=True)
-            texture[i] = texture[i].index_put((s,), g * avg[0])
+            tex = avg[0]
+            if self.lean:  # the weighted average over the window's covered part, times that part
+                w_avg = avg[-2]
+                ok = w_avg > 0
+                tex = torch.where(ok, tex / torch.where(ok, w_avg, torch.ones_like(w_avg)) * avg[-1], torch.zeros_like(tex))
+            texture[i] = texture[i].index_put((s,), g * tex)
             if crest:  # the active and residual covers
                 for c in range(2):
                     f_pix[c][i] = f_pix[c][i].index_put((s,), flat[c] + g * avg[1 + c])
@@ -157,32 +166,94 @@ class SweptTexture:
         zeta_k = torch.asinh(cos_k.double() / self.eps[im]).to(dtype)
         gy_k = (2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez)
         o_t = coordinate(cx[None, None, :], sx[None, None, :], i)
+        lean = (self._lean_samples(im, wf, sw, fpk, cov_k, Xv[0], Yv[0], row, col, smp["slope_x"][0], smp["slope_y"][0],
+                                   cos_k) if self.lean else None)
+        n_cross = 2 + 2 * self.lean  # the cross channels' distance from the volume's end
 
-        def block(u: int, e: int) -> tuple:  # the texture and x at the read samples u:e
-            r_, c_, s_x, s_y = row[u:e], col[u:e], smp["slope_x"][0, u:e], smp["slope_y"][0, u:e]
+        def value(u: int, e: int, s_x: torch.Tensor, s_y: torch.Tensor, ell: torch.Tensor | None) -> tuple:
+            r_, c_ = row[u:e], col[u:e]
             cov_v, cx_v, sx_v = tuple(pick(c, r_) for c in cov_k), pick(cx, c_), pick(sx, c_)
             x_v = resolved_quantile(s_x, s_y, cov_v, cx_v, sx_v)
             read = self._read_volume(vol[i:i + 1], x_v[None, None], pick(o_t, c_)[None, None], pick(gy_k, r_)[None, None],
                                      a[i:i + 1], b[i:i + 1])[0, :, 0]  # (C, e − u)
+            out = read[0]
+            if ell is not None:  # + b ℓ + c ℓ², ℓ the log of the along-view unresolved variance's scale
+                out = out + read[-2] * ell + read[-1] * (ell * ell)
             if not self.cross:
-                return read[0], x_v
+                return out, x_v
             # + g y + h (y² − 1), y the across-view residual of the resolved slope over its rms
             y = _across_quantile(s_x, s_y, cov_v, cx_v, sx_v, x_v)
-            return read[0] + read[-2] * y + read[-1] * (y * y - 1.0), x_v
+            return out + read[-n_cross] * y + read[-n_cross + 1] * (y * y - 1.0), x_v
 
-        grad = torch.is_grad_enabled() and any(v.requires_grad for v in (vol, smp["slope_x"], cov_k[0], gy_k, o_t, a, b))
+        def block(u: int, e: int) -> tuple:  # the texture and x at the read samples u:e
+            s_x, s_y = smp["slope_x"][0, u:e], smp["slope_y"][0, u:e]
+            if lean is None:
+                return value(u, e, s_x, s_y, None)
+            # the unresolved waves' mean slope over the sample's patch added, their along-view variance scaled;
+            # x (for the glint) of the resolved slope alone
+            out, _ = value(u, e, s_x + lean[0][u:e], s_y + lean[1][u:e], lean[2][u:e])
+            r_, c_ = row[u:e], col[u:e]
+            return out, resolved_quantile(s_x, s_y, tuple(pick(c, r_) for c in cov_k), pick(cx, c_), pick(sx, c_))
+
+        grad = torch.is_grad_enabled() and any(v.requires_grad for v in (vol, smp["slope_x"], cov_k[0], gy_k, o_t, a, b)
+                                               + (() if lean is None else lean))
         tex, x_v = in_blocks(block, sel.numel(), max(sel.numel(), 1) if grad else BLOCK)  # (whole with a graph)
+        weights = []
+        if lean is not None:  # each sample weighted by its patch's visible projected area over the node's; the
+            # pixels' averages divide by the weights' own (:meth:`_pixels_swept`)
+            tex = lean[3] * tex
+            weights = [lean[3], torch.ones_like(tex)]
         values = [tex]
         if crest:
             var_r = pick(wf.crest_variance(fpk[None]), row)[None]
             f_act, f_res = whitecap_cover(wf, Xv, Yv, t_s, fv, smp["crest"], var_r, wf.crest_variance()[:, None],
                                           self.p.foam[im:im + 1].to(dtype)[:, None], trails=self.foam_trails)
             values += [f_act[0], f_res[0]]
+        values += weights
         # back to every sample (0 at the hidden ones), in the (nt, ns) layout of the envelope, row by row
         full, at = x_v.new_zeros(len(values), nt * ns), (col * ns).add_(row)
         for c, v in enumerate(values):
             full[c].index_copy_(0, at, v)
         return full.reshape(-1, nt, ns), (sel, x_v), cov_k
+
+    def _lean_samples(self, im: int, wf: Any, sw: Sweep, fpk: torch.Tensor, cov_k: tuple, x: torch.Tensor,
+                      y: torch.Tensor, row: torch.Tensor, col: torch.Tensor, s_x: torch.Tensor, s_y: torch.Tensor,
+                      cos_k: torch.Tensor) -> tuple:
+        """(μ_x, μ_y, ℓ) at the read samples (world points ``x``, ``y``; sweep rows ``row``, tracks ``col``) of
+        image ``im`` (:mod:`~roughsea_torch.renderer.lean`): the unresolved waves' mean slope over each
+        sample's patch (world frame) and ℓ = ln((σ_u² + δ)/σ_u²), clamped to ±ln 3, where σ_u² is the
+        unresolved Gaussian's along-view variance (the scene's total less the reconciled resolved part at
+        the sample's footprint F_s = ``fpk``) and δ = κ² (C − V) along the view, the patch covariance's
+        departure from its expectation. κ = λ √min(1, σ_u² / (λ² V)) maps the field's unresolved bands onto
+        the unresolved Gaussian (λ :func:`~roughsea_torch.clutter.reconcile_scale` at F_s, and never more
+        of it than it holds), so that σ_u² + δ ≥ 0."""
+        p = self.p
+        pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731
+        rho = torch.sqrt(sw.r * sw.r + sw.h * sw.h)
+        # the patch: lean_across · R δ across × the sample's length along the view (half its footprint)
+        patch = torch.sqrt(self.lean_across * rho * self.ifov[im] * 0.5 * sw.footprint)
+        mx, my, cxx, cyy, cxy, vxx, vyy, vxy = ShortWaveMoments(wf, 0, self.time[im:im + 1])(x, y, fpk, patch, row)
+        ex, ey = pick(torch.cos(sw.az), col), pick(torch.sin(sw.az), col)
+        along = lambda c0, c1, c2: c0 * ex * ex + 2.0 * c2 * ex * ey + c1 * ey * ey  # noqa: E731
+        lam = reconcile_scale(cov_k, p.vx[im], p.vy[im], p.cxy[im], p.wind_direction[im])  # (ns,)
+        lam2 = pick(lam * lam, row)
+        wd = p.wind_direction[im].to(self.dtype)
+        cr, sr = pick(torch.cos(sw.az - wd), col), pick(torch.sin(sw.az - wd), col)
+        total = p.vx[im] * cr * cr + 2.0 * p.cxy[im] * cr * sr + p.vy[im] * sr * sr
+        v_u = (total - lam2 * along(*(pick(c, row) for c in cov_k))).clamp_min(1e-12)
+        v_f = along(vxx, vyy, vxy)
+        kappa2 = lam2 * torch.clamp(v_u / (lam2 * v_f).clamp_min(1e-30), max=1.0)
+        kappa = kappa2.sqrt()
+        delta = kappa2 * (along(cxx, cyy, cxy) - v_f)
+        ell = torch.log((v_u + delta).clamp_min(v_u * math.exp(-ELL_CLAMP)) / v_u).clamp(-ELL_CLAMP, ELL_CLAMP)
+        # the patch's visible projected area (Eq. 5's D about the along-view mean and rms) over the node's
+        lam = pick(lam, row)
+        a_r = -(s_x * ex + s_y * ey) * lam
+        mu_a = -(mx * ex + my * ey) * kappa
+        ct = pick(cos_k, row)
+        st = torch.sqrt((1.0 - ct * ct).clamp_min(0.0))
+        w = projected_area(ct + st * (a_r + mu_a), st * torch.sqrt(v_u * torch.exp(ell))) / projected_area(ct + st * a_r, st * v_u.sqrt())
+        return kappa * mx, kappa * my, ell, w
 
 
 def _across_quantile(slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple, dx: torch.Tensor, dy: torch.Tensor,

@@ -29,6 +29,7 @@ from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
 from .hits import sample_step
+from .lean import ELL_NODE, variance_columns
 from .path import path_rows
 from .scene import SceneParameters
 from .sky_terms import sky_per_image
@@ -98,8 +99,13 @@ class TextureTable(SweptTexture):
         # the across-view resolved slope as texture too (first hit): two more channels, the quadratic's
         # coefficients in y = c_r/σ_r (TableSize.texture_hit_cross)
         self.cross = self.first_hit and bool(table.texture_hit_cross)
-        # the volume's channels that are radiances (τ applies): Δ, (x' with a sun: not), (g, h across)
-        self.radiance_channels = [True] + ([False] if scene.sun is not None else []) + [True, True] * self.cross
+        # the unresolved waves' own patch moments at each sample (TableSize.texture_hit_lean): two more
+        # channels, the quadratic's coefficients in ℓ, the log of the along-view unresolved variance's scale
+        self.lean = self.first_hit and bool(table.texture_hit_lean)
+        self.lean_across = float(table.texture_hit_lean_across)
+        # the volume's channels that are radiances (τ applies): Δ, (x' with a sun: not), (g, h across), (lean)
+        self.radiance_channels = ([True] + ([False] if scene.sun is not None else []) + [True, True] * self.cross
+                                  + [True, True] * self.lean)
         self.foam_trails = bool(table.foam_trails)
         self.antialias = bool(table.texture_antialias)  # (renderer.antialias; the sweep is not filtered)
         # the sweep (TableSize.texture_hit_*): samples s(θ̂) pixels apart in depression, each filtered at
@@ -150,8 +156,8 @@ class TextureTable(SweptTexture):
             zero = torch.zeros(b_, 1, nz, nphi, nx, dtype=dtype, device=device)
             if self.scene.sun is not None:
                 zero = torch.cat([zero, self.xnodes.expand(b_, 1, nz, nphi, -1)], 1)
-            if self.cross:
-                zero = torch.cat([zero, zero[:, :1], zero[:, :1]], 1)
+            if self.cross or self.lean:
+                zero = torch.cat([zero] + [zero[:, :1]] * (2 * (self.cross + self.lean)), 1)
             return zero, torch.zeros(b_, dtype=torch.bool, device=device)
         active, idx, ct, ph, moments, x_vis = nodes
         img = idx[0]
@@ -165,10 +171,17 @@ class TextureTable(SweptTexture):
             channels.append(self.xnodes.expand(b_, nz, nphi, -1).clone().index_put(idx, x_vis.to(dtype)))
         if self.cross:  # the last two: g, h of R(y) ≈ R̄ + g y + h (y² − 1), R̄ the along-view node value
             # (the mean over y ~ N(0, 1)), through R(±√3): three-point Gauss–Hermite, exact for the quadratic
-            r_m, r_p = v[:, nx + 1:].unflatten(1, (2, nx)).unbind(1)
+            r_m, r_p = v[:, nx + 1:3 * nx + 1].unflatten(1, (2, nx)).unbind(1)
             r_bar = v[:, :nx]
             channels += [zero.index_put(idx, ((r_p - r_m) / (2.0 * _ROOT3)).to(dtype)),
                          zero.index_put(idx, ((0.5 * (r_p + r_m) - r_bar) / 2.0).to(dtype))]
+        if self.lean:  # the last two: b, c of R(ℓ) ≈ R̄ + b ℓ + c ℓ², through ℓ = ±ln 2 (the along-view unresolved
+            # variance halved and doubled)
+            a0 = nx + 1 + 2 * nx * self.cross
+            r_m, r_p = v[:, a0:a0 + 2 * nx].unflatten(1, (2, nx)).unbind(1)
+            r_bar = v[:, :nx]
+            channels += [zero.index_put(idx, ((r_p - r_m) / (2.0 * ELL_NODE)).to(dtype)),
+                         zero.index_put(idx, ((0.5 * (r_p + r_m) - r_bar) / (ELL_NODE * ELL_NODE)).to(dtype))]
         return torch.stack(channels, 1), active.flatten(1).any(1)
 
     def _active_nodes(self, sl: slice, wf: Any, ph_nodes: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor) -> Any:
@@ -217,6 +230,8 @@ class TextureTable(SweptTexture):
             self._check_eq7(ct, x_vis * va_.sqrt()[:, None], x)
         if self.cross:  # 2 × nx more columns: the resolved across-view residual as geometry at y = ±√3
             moments = self._cross_columns(moments, cov, phw, var_a, kap, full, ph, x.shape[1])
+        if self.lean:  # 2 × nx more: the along-view unresolved variance scaled by ½ and 2
+            moments = variance_columns(moments, ph, x.shape[1])
         return active, idx, ct, ph, moments, x_vis
 
     def _check_eq7(self, ct: torch.Tensor, a_vis: torch.Tensor, x: torch.Tensor) -> None:
