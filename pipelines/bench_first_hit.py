@@ -9,7 +9,8 @@ far-field-heavy camera (20 m mast, pitch −2°: rows from 170 m to the horizon)
 timed in turn within one loop (so the machine's load falls on all of them), median of ``--repeats``,
 with 1 and 2 torch threads. ``--baseline DIR``: a checkout (e.g. ``git archive main roughsea_torch | tar -x
 -C DIR``) whose ``roughsea_torch`` is loaded beside this one under another name and timed as
-"first-hit, baseline". Variants: ``TableSize`` fields of approximate sweeps, timed as well.
+"first-hit, baseline". Variants: ``TableSize`` fields of approximate sweeps and the sweep with the unresolved
+waves' patch moments (``texture_hit_lean``), timed as well.
 
 Then, 1 thread, where the first-hit render's time goes (each stage timed around its call, the rest of
 the render left to "other"), and the sweep's size: samples per track, tracks, samples per pixel, the
@@ -39,6 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _report import write_report  # noqa: E402
 
 import roughsea_torch as rs  # noqa: E402
+import roughsea_torch.renderer.swept as sx  # noqa: E402
 import roughsea_torch.renderer.texture as tx  # noqa: E402
 import roughsea_torch.waves as wv  # noqa: E402
 import roughsea_torch.whitecaps as wc  # noqa: E402
@@ -50,7 +52,8 @@ FAR_CAMERA = dict(hfov_deg=12.0, altitude_m=20.0, pitch_deg=-2.0)  # timed at 51
 CAMERAS = {"15 m, −6°": CAMERA, "20 m, −2°": FAR_CAMERA}
 VARIANTS = {"first-hit, across 2": dict(texture_hit_across=2.0),
             "first-hit, min_step 1/16": dict(texture_hit_min_step=0.0625),
-            "first-hit, across 2, min_step 1/16": dict(texture_hit_across=2.0, texture_hit_min_step=0.0625)}
+            "first-hit, across 2, min_step 1/16": dict(texture_hit_across=2.0, texture_hit_min_step=0.0625),
+            "first-hit, patch moments (texture_hit_lean)": dict(texture_hit_lean=True)}
 
 
 def load_baseline(path: str):
@@ -94,7 +97,8 @@ def timings(fns: dict, repeats: int) -> dict:
 
 class Stages:
     """Wall time spent in the sweep's stages of one first-hit render (1 thread), each function of
-    renderer/texture.py's namespace (or of the WaveField) wrapped with a timer; and the sweep's size."""
+    renderer/swept.py's namespace (or of the WaveField, or the texture table's volume read) wrapped with a
+    timer; and the sweep's size."""
 
     WRAPPED = {"layout (sample points)": "sweep_layout", "envelope (running minimum)": "sweep_envelope",
                "visible samples": "visible_samples", "pixels' windows: search and average": "pixel_hits",
@@ -108,7 +112,7 @@ class Stages:
         self.size = {}
 
     def run(self, render) -> float:
-        saved = {n: getattr(tx, n) for n in self.WRAPPED.values() if hasattr(tx, n)}
+        saved = {n: getattr(sx, n) for n in self.WRAPPED.values() if hasattr(sx, n)}
         sample, read, streaks = wv.WaveField.sample_unchecked, tx.TextureTable._read_volume, wc.streak_noise
 
         def timed(label, f):
@@ -135,7 +139,7 @@ class Stages:
 
         for label, n in self.WRAPPED.items():
             if n in saved:
-                setattr(tx, n, timed(label, saved[n]))
+                setattr(sx, n, timed(label, saved[n]))
         wv.WaveField.sample_unchecked = sample_timed
         tx.TextureTable._read_volume = timed("texture volume reads", read)
         wc.streak_noise = timed(self.NESTED, streaks)
@@ -145,7 +149,7 @@ class Stages:
             return time.perf_counter() - t0
         finally:
             for n, f in saved.items():
-                setattr(tx, n, f)
+                setattr(sx, n, f)
             wv.WaveField.sample_unchecked, tx.TextureTable._read_volume, wc.streak_noise = sample, read, streaks
 
 

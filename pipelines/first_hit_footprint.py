@@ -8,7 +8,7 @@ makes the footprint grow past ``across`` · R δ (2.1 R δ at 88°), and the sam
 unresolved statistics at that footprint, responds less to the resolved slope (``docs/texture_first_sigma.md``).
 Here the footprint takes its own floor ``fp_min_step`` (< ``min_step``): samples stay ``min_step`` apart,
 filtered at 2 max(``across`` cos θ̂ / 2, ``fp_min_step``) R δ / cos θ̂, and the texture volume's nodes
-at the same footprints. The patch replaces ``sweep_layout`` as ``renderer.texture`` calls it (the sweep's
+at the same footprints. The patch replaces ``sweep_layout`` as ``renderer.swept`` calls it (the sweep's
 footprints recomputed from its sample distances) and ``TextureTable._scale``.
 
 Usage (from the comparison pipeline's saved pickle; prints σ per bin and the criteria):
@@ -27,6 +27,7 @@ import torch
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import roughsea_torch.renderer.swept as sx  # noqa: E402
 import roughsea_torch.renderer.texture as tx  # noqa: E402
 from roughsea_torch.clutter import footprint  # noqa: E402
 from roughsea_torch.renderer import hits  # noqa: E402
@@ -55,12 +56,12 @@ def patch(fp_min_step: float, fp_across: float | None = None) -> None:
     def scale(self, cos_view):
         return 2.0 * fp_step(cos_view, **self.hit_steps) if self.first_hit else 1.0
 
-    tx.sweep_layout = layout
+    sx.sweep_layout = layout
     tx.TextureTable._scale = scale
 
 
 def unpatch() -> None:
-    tx.sweep_layout = ORIGINAL_LAYOUT
+    sx.sweep_layout = ORIGINAL_LAYOUT
     tx.TextureTable._scale = ORIGINAL_SCALE
 
 

@@ -123,6 +123,8 @@ TESTS: dict[str, list[str]] = {
     "renderer/glint": _first("tests/renderer/test_glint.py", DAY, ["tests/test_augmentation.py"]),
     "renderer/texture": _first("tests/renderer/test_texture.py", ["tests/test_clutter.py", "tests/test_foam.py"], DAY),
     "renderer/hits": _first("tests/renderer/test_hits.py", ["tests/renderer/test_texture.py"]),
+    "renderer/swept": _first("tests/renderer/test_hits.py", ["tests/renderer/test_texture.py", "tests/renderer/test_lean.py"]),
+    "renderer/lean": _first("tests/renderer/test_lean.py"),
     "renderer/antialias": _first("tests/renderer/test_antialias.py", ["tests/renderer/test_texture.py", "tests/test_clutter.py",
                                                                        "tests/test_foam.py"]),
     "renderer/table": _first("tests/renderer/test_table.py", RENDER, DAY, ["tests/test_clutter.py"]),
@@ -481,7 +483,7 @@ NOTES[('renderer/texture', '_active_nodes() 1e-10 * suu  →  (1e-10 / suu)')] =
     'over 10 scenes: night anisotropic, correlated and wide; day with the glint, with and without '
     'aerosol; nadir night and day; textured night and day; and the sweep against itself): unchanged'
 )
-NOTES[('renderer/texture', '_swept_samples() 2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype)  →  (2.0 * (zeta_k - lo[i].to(dtype)) * span_z[i].to(dtype))')] = (
+NOTES[('renderer/swept', '_swept_samples() 2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype)  →  (2.0 * (zeta_k - lo[i].to(dtype)) * span_z[i].to(dtype))')] = (
     "NOT KILLED, changes a physical number of an option: the sweep (TableSize(texture_hit='first'), off "
     'by default) reads its samples at wrong table coordinates, 2e-3 relative in a 10 m/s scene; no test '
     'checks the sweep against an independent evaluation at that accuracy (per-pixel evaluation takes the '
