@@ -93,7 +93,8 @@ HIT_OPTIONS = (("--hit-step", "texture_hit_step", "largest sample spacing in dep
                ("--hit-min-step", "texture_hit_min_step", "smallest sample spacing [px]"),
                ("--hit-across", "texture_hit_across", "spacing across * cos(view zenith) / 2 [px]"),
                ("--hit-tracks", "texture_hit_tracks", "ground tracks per pixel width"),
-               ("--hit-visibility", "texture_hit_visibility", "elevation of the visibility at this x the sample footprint"))
+               ("--hit-visibility", "texture_hit_visibility", "elevation of the visibility at this x the sample footprint"),
+               ("--hit-lean-across", "texture_hit_lean_across", "with --hit-lean: the patch's width across the view [R delta]"))
 
 
 def _masking_name(option: str) -> str:
@@ -521,7 +522,8 @@ def reading(cases: list[dict], ens: list[dict], spec: list[dict]) -> list[str]:
 def report(args, cases, ens, spec, ident, timings, command, date) -> str:
     hit = getattr(args, "texture_hit", "flat")
     sfx = getattr(args, "suffix", "" if hit == rs.TableSize().texture_hit else f"_{hit}")
-    sweep = "".join(f", {field}={v:g}" for field, v in getattr(args, "hit_settings", {}).items())
+    sweep = "".join(f", {field}={v!r}" if isinstance(v, bool) else f", {field}={v:g}"
+                    for field, v in getattr(args, "hit_settings", {}).items())
     lines = [
         "# Textured renders against a brute-force ray tracer of the same realization",
         "",
@@ -734,6 +736,8 @@ def main() -> None:
     for flag, field, what in HIT_OPTIONS:
         ap.add_argument(flag, type=float, default=None,
                         help=f"TableSize.{field} of the textured renders ({what}; default: the renderer's)")
+    ap.add_argument("--hit-lean", action="store_true",
+                    help="TableSize.texture_hit_lean: the unresolved waves' own slope moments over each sweep sample's patch")
     ap.add_argument("--shadowing", choices=("eq5", "correlated", "multiscale"), default="eq5",
                     help="SeaScene(shadowing=) of the textured renders: the paper's Eq. 5 (default), 'correlated' or "
                          "'multiscale'")
@@ -754,9 +758,10 @@ def main() -> None:
     RAY_SHADOWING = True if args.ray_shadowing == "eq5" else args.ray_shadowing
     hit = {field: getattr(args, flag[2:].replace("-", "_")) for flag, field, _ in HIT_OPTIONS}
     hit = {k: v for k, v in hit.items() if v is not None}
-    TABLE = rs.TableSize(texture_hit=args.texture_hit, **hit)
+    TABLE = rs.TableSize(texture_hit=args.texture_hit, texture_hit_lean=args.hit_lean, **hit)
     suffix = "" if args.texture_hit == rs.TableSize().texture_hit else f"_{args.texture_hit}"
     suffix += "".join(f"_{flag[6:]}{v:g}" for flag, field, _ in HIT_OPTIONS if (v := hit.get(field)) is not None)
+    suffix += "_lean" if args.hit_lean else ""
     suffix += f"_{args.shadowing}" if args.shadowing != "eq5" else ""
     suffix += f"_ray{args.ray_shadowing}" if args.ray_shadowing != "eq5" and not (args.replot or args.retexture) else ""
     suffix += f"_seed{SEED}" if (SEED, TIME_S) != (11, 3.0) else ""
@@ -777,6 +782,7 @@ def main() -> None:
         Path(args.out).mkdir(parents=True, exist_ok=True)
         command = saved["command"] + (f" --texture-hit {args.texture_hit}" if args.texture_hit != "flat" else "")
         command += "".join(f" {flag} {v:g}" for flag, field, _ in HIT_OPTIONS if (v := hit.get(field)) is not None)
+        command += " --hit-lean" if args.hit_lean else ""
         command += f" --cases {' '.join(args.cases)}" if args.cases else ""
         command += f" --shadowing {args.shadowing}" if args.shadowing != "eq5" else ""
         ray_sh = getattr(saved["args"], "ray_shadowing", "eq5")  # the saved trace's
@@ -786,7 +792,8 @@ def main() -> None:
         if args.retexture:
             command += f"  (textured side again: --retexture, {dt.date.today().isoformat()})"
         saved["args"].texture_hit = args.texture_hit
-        saved["args"].suffix, saved["args"].hit_settings = suffix, hit
+        saved["args"].suffix = suffix
+        saved["args"].hit_settings = dict(hit, **({"texture_hit_lean": True} if args.hit_lean else {}))
         if not hasattr(saved["args"], "threads"):  # a pickle of an earlier version
             saved["args"].threads = torch.get_num_threads()
         figures(Path(args.out), cases, ens, suffix)
@@ -794,7 +801,7 @@ def main() -> None:
                                                                         saved["ident"], saved["timings"], command,
                                                                         saved["date"]))
         return
-    args.suffix, args.hit_settings = suffix, hit
+    args.suffix, args.hit_settings = suffix, dict(hit, **({"texture_hit_lean": True} if args.hit_lean else {}))
     winds = (5.0, 15.0) if args.quick else (5.0, 10.0, 15.0)
     args.rays = 16 if args.quick else 128 if args.full else 64
     args.seeds = list(range(100, 102 if args.quick else (132 if args.full else 116)))
@@ -807,6 +814,7 @@ def main() -> None:
     command = ("python pipelines/texture_vs_raytrace.py" + (" --quick" if args.quick else " --full" if args.full else "")
                + (f" --texture-hit {args.texture_hit}" if args.texture_hit != rs.TableSize().texture_hit else "")
                + "".join(f" {flag} {v:g}" for flag, field, _ in HIT_OPTIONS if (v := hit.get(field)) is not None)
+               + (" --hit-lean" if args.hit_lean else "")
                + (f" --cases {' '.join(args.cases)}" if args.cases else "")
                + (f" --shadowing {args.shadowing}" if args.shadowing != "eq5" else "")
                + (f" --ray-shadowing {args.ray_shadowing}" if args.ray_shadowing != "eq5" else "")
