@@ -89,7 +89,9 @@ def _group_scene(params: dict[str, torch.Tensor], idx: torch.Tensor, sky: str, t
     # from a second idle core and stall beside a busy process (roughsea_torch._parallel); the renders
     # themselves are spread by render_frames
     return one_thread(lambda: SeaScene(
-        wind_speed=f("wind_speed"), anisotropic=anisotropic, wind_direction=f("wind_direction_deg") * (math.pi / 180.0),
+        # (the drawn degrees wrapped into [0, 360): the same direction, and SeaScene warns of more than a turn)
+        wind_speed=f("wind_speed"), anisotropic=anisotropic,
+        wind_direction=torch.remainder(f("wind_direction_deg"), 360.0) * (math.pi / 180.0),
         sea_temperature=f("sea_temperature"), air_temperature=f("air_temperature"), band=band,
         sky=sky, path=None if path else False,
         seed=[int(s) for s in params["wave_seed"][idx.to(params["wave_seed"].device)].tolist()] if textured else None,

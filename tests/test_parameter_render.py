@@ -5,6 +5,7 @@ alone), textured draws with their seed and time."""
 from __future__ import annotations
 
 import math
+import warnings
 
 import torch
 
@@ -54,3 +55,18 @@ def test_textured_parameters_reach_the_renderer():
         torch.testing.assert_close(img[i : i + 1], rs.render(cam, scene), rtol=1e-7, atol=0.0)
         scene.time_s = float(p["time_s"][i]) + 5.0  # another moment of the same sea is another image
         assert not torch.allclose(img[i : i + 1], rs.render(cam, scene), rtol=1e-5, atol=0.0)
+
+
+def test_drawn_wind_directions_beyond_a_turn_render_silently_as_the_same_direction():
+    """The samplers accept wind directions in [−3600, 3600]°; drawn beyond a full turn they are the same
+    direction wrapped, so rendering them neither triggers SeaScene's degrees warning (radians beyond 2π) nor
+    changes the image: a textured batch drawn in [360, 720)° equals the same draws less 360° (to 1e-9 in
+    float64, relative: the wrap rounds the angle's last bits)."""
+    s = SceneSampler(wind_direction_deg=(360.0, 720.0), texture=True, pitch_deg=(-10.0, -4.0))
+    p = s.sample(2, generator=torch.Generator().manual_seed(4))
+    q = dict(p, wind_direction_deg=p["wind_direction_deg"] - 360.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        a = render_parameters(p, H, W, s.atmospheres, dtype=torch.float64)
+        b = render_parameters(q, H, W, s.atmospheres, dtype=torch.float64)
+    assert float(((a - b) / b).abs().max()) < 1e-9

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import threading
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -259,6 +260,7 @@ class SeaScene:
         if not isinstance(slopes, SlopeStatistics):
             raise ValueError(f"slopes must be a SlopeStatistics; got {type(slopes).__name__}")
         check_finite_range("wind_direction", wind_direction, -MAX_WIND_DIRECTION, MAX_WIND_DIRECTION, unit="rad")
+        _warn_degrees(wind_direction)
         if sea_temperature is not None:
             check_finite_range("sea_temperature", sea_temperature, 200.0, 350.0, unit="K")
         if sea_radiance is not None:
@@ -511,3 +513,15 @@ class SeaScene:
         return SceneParameters(vx=vx, vy=vy, cxy=cxy, wind_direction=wd, rb=rb, n=n.expand(B), k=k.expand(B), sky=self.sky,
                                foam=foam, air_scale=air_scale,
                                skin_deficit=per_batch("skin_deficit", self.skin_deficit, B, dtype, device))
+
+
+def _warn_degrees(wind_direction: Any) -> None:
+    """A warning, pointing at the caller's caller (the user's ``SeaScene(...)`` line), where some wind direction
+    exceeds 2π in magnitude: ``SeaScene`` takes radians (the samplers and augmentations take degrees), and
+    45.0 rad is almost surely 45° passed as it is. Larger angles stay valid (they wrap)."""
+    big = float(torch.as_tensor(wind_direction).detach().abs().max()) if np.size(wind_direction) else 0.0
+    if big > 2.0 * math.pi * (1.0 + 1e-6):
+        warnings.warn(f"SeaScene(wind_direction=...): {big:g} rad is more than a full turn; wind_direction is in "
+                      f"radians (world azimuth of the upwind axis). For degrees pass math.radians({big:g}).",
+                      stacklevel=3)
+

@@ -8,6 +8,7 @@ the numpy reference)."""
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -430,3 +431,18 @@ def test_masked_shadowing_reaches_table_and_direct_renders(option, most):
     for bad in ("wagner", None, 2):
         with pytest.raises(ValueError, match="shadowing"):
             make_scene(shadowing=bad)
+
+
+def test_wind_direction_beyond_a_full_turn_warns_of_degrees():
+    """SeaScene takes the wind direction in radians (the samplers take degrees): 45.0, almost surely 45°, warns
+    at the user's line, naming radians and math.radians; directions within ±2π (2π itself, in float32 too) and
+    per-image tensors within it do not warn. Larger angles stay valid (a warning, not an error)."""
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        scene = rs.SeaScene(wind_speed=8.0, wind_direction=45.0, sea_temperature=290.0)
+    assert len(got) == 1 and "radians" in str(got[0].message) and "math.radians(45)" in str(got[0].message)
+    assert got[0].filename == __file__ and scene.wind_direction == 45.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for wd in (1.0, 2.0 * math.pi, -2.0 * math.pi, torch.tensor([0.1, 6.0]), torch.tensor(2.0 * math.pi, dtype=torch.float32)):
+            rs.SeaScene(wind_speed=8.0, wind_direction=wd, sea_temperature=290.0)
