@@ -13,7 +13,10 @@ waves over the patch the sample stands for: with u_o = 1 − w_o(F_s) the unreso
 
 ⟨·⟩_P the average over the patch P (bands are independent: their cross products average out, and are
 left out). The renderer adds μ to the resolved slope where it reads its texture, and scales the
-unresolved Gaussian's along-view variance by its patch value (``TableSize.texture_hit_lean``). Over all
+unresolved Gaussian's along-view variance by its patch value, both as far as the unresolved Gaussian holds
+the field's bands (a factor κ ≤ 1), and weights each sample by its patch's visible projected area
+(:func:`projected_area`, :func:`weighted_window`; ``TableSize.texture_hit_lean``,
+:mod:`~roughsea_torch.renderer.swept`). Over all
 positions E[μμᵀ] + E[C] = Σ_o u_o² C_o, the unresolved bands' own covariance: the two moments
 redistribute the unresolved variance between the samples, they add none.
 
@@ -47,7 +50,8 @@ import torch.nn.functional as F
 from ..facets import normal_cdf, normal_pdf
 from ..wave_bands import band_window
 
-__all__ = ["ShortWaveMoments", "variance_columns", "projected_area", "LEVELS", "CONSTANT_LEVEL", "ELL_NODE",
+__all__ = ["ShortWaveMoments", "variance_columns", "log_variance_quadratic", "projected_area",
+           "weighted_window", "LEVELS", "CONSTANT_LEVEL", "ELL_NODE",
            "ELL_CLAMP"]
 
 LEVELS = (-2, -1, 0, 1)  # log₂(patch / band wavelength) of the filtered tiles
@@ -191,6 +195,21 @@ def variance_columns(moments: list, ph: torch.Tensor, nx: int) -> list:
         cols[2].append(cv + d * (c * w1 + s * w0) + d * d * q * c * s)
     out = [torch.cat([m] + e, 1) for m, e in zip(moments[:3], cols)]
     return out + [torch.cat([m, mean, mean], 1) for m, mean in zip(moments[3:], (mu, mc))]
+
+
+def log_variance_quadratic(r_minus: torch.Tensor, r_bar: torch.Tensor, r_plus: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """(b, c) of R(ℓ) ≈ R̄ + b ℓ + c ℓ² through the node values at ℓ = −ln 2, 0, ln 2 (``r_minus``, ``r_bar``,
+    ``r_plus``: the along-view unresolved variance halved, as it is, doubled; :func:`variance_columns`)."""
+    return (r_plus - r_minus) / (2.0 * ELL_NODE), (0.5 * (r_plus + r_minus) - r_bar) / (ELL_NODE * ELL_NODE)
+
+
+def weighted_window(wx: torch.Tensor, w: torch.Tensor, covered: torch.Tensor) -> torch.Tensor:
+    """A pixel's weighted average of a quantity x over its window's covered part, times that part, from the
+    window averages (:func:`~roughsea_torch.renderer.hits.visible_average`) of w x, of the weights w and of 1
+    (the covered share: the window beyond the sweep counts 0): ⟨w x⟩ / ⟨w⟩ · ⟨1⟩, 0 where ⟨w⟩ = 0. With w = 1
+    it is ⟨x⟩, the unweighted average."""
+    ok = w > 0
+    return torch.where(ok, wx / torch.where(ok, w, torch.ones_like(w)) * covered, torch.zeros_like(wx))
 
 
 def projected_area(e: torch.Tensor, a: torch.Tensor) -> torch.Tensor:

@@ -112,10 +112,12 @@ class TableSize:
         texture_hit_lean, texture_hit_lean_across: with ``texture_hit="first"``, the unresolved waves'
             own slopes at each sweep sample (default False): their mean and covariance over the sample's
             patch (``texture_hit_lean_across`` · R δ across the view × the sample's length along it, taken
-            isotropic with that area; :mod:`~roughsea_torch.renderer.lean`), the mean added to the
-            resolved slope where the texture is read, the covariance's along-view variance scaling the
-            unresolved Gaussian's (two more evaluations per node: a quadratic in the log of that scale
-            through ×½ and ×2). Near grazing at light wind a pixel holds few patches of the waves
+            isotropic with that area; :mod:`~roughsea_torch.renderer.lean`), the mean (as much of it as the
+            unresolved Gaussian holds) added to the resolved slope where the texture is read, the
+            covariance's along-view variance scaling the unresolved Gaussian's (two more evaluations per
+            node: a quadratic in the log of that scale through ×½ and ×2), each sample weighted by its
+            patch's visible projected area. Pair it with ``SeaScene(shadowing="multiscale")``; 1.6–1.8×
+            the first hit's time. Near grazing at light wind a pixel holds few patches of the waves
             shorter than the samples' footprint, and their realization carries clutter an expectation
             over them does not (``docs/subpixel_clutter.md``).
         texture_antialias: True (default): the flat-point texture and crest-foam fraction are

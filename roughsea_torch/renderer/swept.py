@@ -23,7 +23,7 @@ from ..geometry import slant_range
 from ..whitecaps import whitecap_cover
 from .hits import (Sweep, covers, flat_nonzero, footprint_fade, nonzero_2d, pixel_hits, pixel_windows, read_at,
                    sweep_envelope, sweep_layout, track_windows, visible_samples)
-from .lean import ELL_CLAMP, ShortWaveMoments, projected_area
+from .lean import ELL_CLAMP, ShortWaveMoments, projected_area, weighted_window
 
 __all__ = ["SweptTexture"]
 
@@ -78,11 +78,8 @@ class SweptTexture:
             window = track_windows(sw.shape[1], j.index_select(0, on), tau_t.index_select(0, on), tau_b.index_select(0, on))
             values, x_k, cov_k = self._swept_samples(im, i, wf, sw, m, window, vol, lo, span_z, a, b, coordinate, crest)
             avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g, overwrite=True)
-            tex = avg[0]
-            if self.lean:  # the weighted average over the window's covered part, times that part
-                w_avg = avg[-2]
-                ok = w_avg > 0
-                tex = torch.where(ok, tex / torch.where(ok, w_avg, torch.ones_like(w_avg)) * avg[-1], torch.zeros_like(tex))
+            # (with the patch moments: the weighted average over the window's covered part, times that part)
+            tex = weighted_window(avg[0], avg[-2], avg[-1]) if self.lean else avg[0]
             texture[i] = texture[i].index_put((s,), g * tex)
             if crest:  # the active and residual covers
                 for c in range(2):
@@ -219,14 +216,18 @@ class SweptTexture:
     def _lean_samples(self, im: int, wf: Any, sw: Sweep, fpk: torch.Tensor, cov_k: tuple, x: torch.Tensor,
                       y: torch.Tensor, row: torch.Tensor, col: torch.Tensor, s_x: torch.Tensor, s_y: torch.Tensor,
                       cos_k: torch.Tensor) -> tuple:
-        """(μ_x, μ_y, ℓ) at the read samples (world points ``x``, ``y``; sweep rows ``row``, tracks ``col``) of
-        image ``im`` (:mod:`~roughsea_torch.renderer.lean`): the unresolved waves' mean slope over each
-        sample's patch (world frame) and ℓ = ln((σ_u² + δ)/σ_u²), clamped to ±ln 3, where σ_u² is the
-        unresolved Gaussian's along-view variance (the scene's total less the reconciled resolved part at
-        the sample's footprint F_s = ``fpk``) and δ = κ² (C − V) along the view, the patch covariance's
+        """(μ_x, μ_y, ℓ, w) at the read samples (world points ``x``, ``y``; sweep rows ``row``, tracks ``col``;
+        the resolved slopes ``s_x``, ``s_y`` there; ``cos_k`` (ns,) the rows' cos θ̂) of image ``im``
+        (:mod:`~roughsea_torch.renderer.lean`). The model's slope moves by κ μ, μ the unresolved waves' mean
+        slope over each sample's patch (world frame); returned is the shift of the field's slope that does it,
+        κ μ / λ (the volume is read at the raw slope's x). ℓ = ln((σ_u² + δ)/σ_u²), clamped to ±ln 3, where
+        σ_u² is the unresolved Gaussian's along-view variance (the scene's total less the reconciled resolved
+        part at the sample's footprint F_s = ``fpk``) and δ = κ² (C − V) along the view, the patch covariance's
         departure from its expectation. κ = λ √min(1, σ_u² / (λ² V)) maps the field's unresolved bands onto
         the unresolved Gaussian (λ :func:`~roughsea_torch.clutter.reconcile_scale` at F_s, and never more
-        of it than it holds), so that σ_u² + δ ≥ 0."""
+        of it than it holds), so that σ_u² + δ ≥ 0. w: the patch's visible projected area over the node's
+        (Eq. 5's D, :func:`~roughsea_torch.renderer.lean.projected_area`, about λ a + κ μ∥ with σ_u² e^ℓ,
+        against λ a with σ_u²)."""
         p = self.p
         pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731
         rho = torch.sqrt(sw.r * sw.r + sw.h * sw.h)
@@ -253,7 +254,10 @@ class SweptTexture:
         ct = pick(cos_k, row)
         st = torch.sqrt((1.0 - ct * ct).clamp_min(0.0))
         w = projected_area(ct + st * (a_r + mu_a), st * torch.sqrt(v_u * torch.exp(ell))) / projected_area(ct + st * a_r, st * v_u.sqrt())
-        return kappa * mx, kappa * my, ell, w
+        # the shift of the field's slope that moves the model's (λ times it, the volume's x = a/σ_a of the raw
+        # slope, docs/texture.md §7) by κ μ
+        shift = kappa / lam
+        return shift * mx, shift * my, ell, w
 
 
 def _across_quantile(slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple, dx: torch.Tensor, dy: torch.Tensor,

@@ -29,7 +29,7 @@ from ..slopes import SlopeStatistics
 from ..whitecaps import whitecap_cover
 from .antialias import FOAM_TAPS, TEXTURE_TAPS, filter_columns
 from .hits import sample_step
-from .lean import ELL_NODE, variance_columns
+from .lean import log_variance_quadratic, variance_columns
 from .path import path_rows
 from .scene import SceneParameters
 from .sky_terms import sky_per_image
@@ -179,9 +179,7 @@ class TextureTable(SweptTexture):
             # variance halved and doubled)
             a0 = nx + 1 + 2 * nx * self.cross
             r_m, r_p = v[:, a0:a0 + 2 * nx].unflatten(1, (2, nx)).unbind(1)
-            r_bar = v[:, :nx]
-            channels += [zero.index_put(idx, ((r_p - r_m) / (2.0 * ELL_NODE)).to(dtype)),
-                         zero.index_put(idx, ((0.5 * (r_p + r_m) - r_bar) / (ELL_NODE * ELL_NODE)).to(dtype))]
+            channels += [zero.index_put(idx, c_.to(dtype)) for c_ in log_variance_quadratic(r_m, v[:, :nx], r_p)]
         return torch.stack(channels, 1), active.flatten(1).any(1)
 
     def _active_nodes(self, sl: slice, wf: Any, ph_nodes: torch.Tensor, lo: torch.Tensor, span_z: torch.Tensor) -> Any:

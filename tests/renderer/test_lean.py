@@ -12,8 +12,13 @@ import pytest
 import torch
 
 import roughsea_torch as rs
+from roughsea_torch.expectation import apparent_radiance
+from roughsea_torch.lowtran import load_sky
+from roughsea_torch.optics import band_refractive_index
+from roughsea_torch.radiometry import LWIR, band_radiance
 from roughsea_torch.raytrace import raytraced_image
-from roughsea_torch.renderer.lean import LEVELS, ShortWaveMoments
+from roughsea_torch.renderer.lean import LEVELS, ShortWaveMoments, log_variance_quadratic, variance_columns
+from roughsea_torch.slopes import SlopeStatistics
 from roughsea_torch.wave_bands import WaveBands, band_window
 
 F64 = torch.float64
@@ -24,14 +29,16 @@ def _one_band_field():
     return rs.WaveField(5.0, seed=3, dtype=F64, bands=BAND)
 
 
-@pytest.mark.parametrize("level", [-1, 0, 1])
+@pytest.mark.parametrize("level", [-1, 0, 1, -1.5, -0.5, 0.5, 1.5])
 def test_patch_moments_are_the_gaussian_weighted_moments_of_the_slopes(level):
     """For one band wholly unresolved (footprint 1 m: window 0), the patch mean and covariance at a patch of
     2^level wavelengths are the slopes' own Gaussian-weighted mean and covariance (standard deviation
     p/√12), computed here directly from ``WaveField.sample`` on a dense grid about each point (spacing λ/48,
-    to ±5 standard deviations): to 2 % of the slopes' rms and 3 % of their variance (measured ≤ 0.12 % and
-    ≤ 1.2 %: the tiles filter the texels' products, the direct sum the products of bilinear reads). Planted,
-    the filter's width p/√12 taken as p/2: 39 % and 28 % at level −1, 36 % and 16 % at 0."""
+    to ±5 standard deviations). At the filtered levels to 2 % of the slopes' rms and 3 % of their variance
+    (measured ≤ 0.12 % and ≤ 1.2 %: the tiles filter the texels' products, the direct sum the products of
+    bilinear reads); halfway between levels, where two are blended, to 8 % and 7 % (measured ≤ 6.2 % and
+    ≤ 4.9 %). Planted, the filter's width p/√12 taken as p/2: 39 % and 28 % at level −1, 36 % and 16 % at 0;
+    the nearest level instead of the blend: 22–26 % of the rms at ±0.5."""
     field = _one_band_field()
     t = torch.tensor([2.0], dtype=F64)
     lam = 2.0 * math.pi / BAND.band_wavenumber[0]
@@ -54,8 +61,9 @@ def test_patch_moments_are_the_gaussian_weighted_moments_of_the_slopes(level):
         ex, ey = (w * sx).sum(), (w * sy).sum()
         direct = (ex, ey, (w * sx * sx).sum() - ex * ex, (w * sy * sy).sum() - ey * ey, (w * sx * sy).sum() - ex * ey)
         got = (mx[i], my[i], cxx[i], cyy[i], cxy[i])
-        assert max(abs(float(g - d)) for g, d in zip(got[:2], direct[:2])) < 0.02 * rms, (got, direct)
-        assert max(abs(float(g - d)) for g, d in zip(got[2:], direct[2:])) < 0.03 * rms * rms, (got, direct)
+        tol_mean, tol_cov = (0.02, 0.03) if float(level).is_integer() else (0.08, 0.07)
+        assert max(abs(float(g - d)) for g, d in zip(got[:2], direct[:2])) < tol_mean * rms, (got, direct)
+        assert max(abs(float(g - d)) for g, d in zip(got[2:], direct[2:])) < tol_cov * rms * rms, (got, direct)
 
 
 def test_patch_mean_and_covariance_redistribute_the_unresolved_variance():
@@ -132,9 +140,10 @@ def test_patch_moments_bring_light_wind_clutter_towards_the_ray_trace():
     against the brute-force ray trace of each (32 rays per pixel, the untraced waves with the same
     multi-scale masking, its sampling noise removed): without the patch moments the swept render's clutter
     σ, pooled over the four, is 0.74 of the trace's (finite sampling of the 10 cm – 1 m waves a pixel holds,
-    ``docs/subpixel_clutter.md``); with them it gains at least 0.05 and stays below 1.2, and the mean
-    per-pixel correlation with the trace does not fall (measured 0.744 → 0.827, correlation 0.66 → 0.73).
-    Planted, the patch mean and variance taken at the expectation (μ = 0, ℓ = 0): no gain, and the test
+    ``docs/subpixel_clutter.md``); with them it gains at least 0.065 and stays below 1.2, and the mean
+    per-pixel correlation with the trace gains at least 0.05 (measured 0.744 → 0.827, correlation 0.659 →
+    0.728). Each moment gives about half: planted, the mean alone (ℓ = 0) 0.794 and 0.696, the variance
+    alone (μ = 0) 0.786 and 0.687, ℓ clamped to ±0.05 0.795 and 0.708, neither (μ = 0, ℓ = 0) no gain: each
     fails."""
     seeds = [23, 11, 5, 7]
     cams = rs.make_camera(8, 32, hfov_deg=6.0, altitude_m=15.0, pitch_deg=-2.5, dtype=F64, batch_size=len(seeds))
@@ -152,8 +161,8 @@ def test_patch_moments_bring_light_wind_clutter_towards_the_ray_trace():
         var = a.pow(2).mean((1, 2))
         ratio[lean] = float((var.sum() / var_ray.sum()).sqrt())
         corr[lean] = float(((a * b).mean((1, 2)) / (var * var_ray).sqrt()).mean())
-    assert ratio[False] < 0.8 and ratio[False] + 0.05 < ratio[True] < 1.2, ratio
-    assert corr[True] >= corr[False], corr
+    assert ratio[False] < 0.8 and ratio[False] + 0.065 < ratio[True] < 1.2, ratio
+    assert corr[True] >= corr[False] + 0.05, corr
 
 
 def test_patch_moments_weighted_by_their_visible_area_keep_the_ensemble_mean():
@@ -174,3 +183,81 @@ def test_patch_moments_weighted_by_their_visible_area_keep_the_ensemble_mean():
     d = img[True] - img[False]
     assert float(d.pow(2).mean().sqrt()) > 0.02  # the patch moments are there
     assert abs(float(d.mean())) < 0.03, float(d.mean())
+
+
+def test_variance_columns_scale_the_along_view_variance_alone():
+    """The table's extra node columns scale the unresolved covariance's along-view variance by ½ and 2 and keep
+    the across-view one: looking upwind (φ̂ = 0) var_upwind × e^ℓ, the covariance × e^{ℓ/2}, var_crosswind
+    kept; looking crosswind (φ̂ = π/2) the other way round; at φ̂ = 0.7 the view-frame variances, computed
+    here by rotation. The means are copied. Planted, the columns at ¼ and 4: fails."""
+    vu, vc, cv, mu, mc = (torch.tensor([[x]], dtype=F64) for x in (0.012, 0.008, 0.001, 0.03, -0.01))
+    for ph in (0.0, math.pi / 2, 0.7):
+        cols = variance_columns([vu, vc, cv, mu, mc], torch.tensor([ph], dtype=F64), 1)
+        rot = torch.tensor([[math.cos(ph), -math.sin(ph)], [math.sin(ph), math.cos(ph)]], dtype=F64)
+        view = rot.T @ torch.tensor([[0.012, 0.001], [0.001, 0.008]], dtype=F64) @ rot  # (along, across)
+        for k, ell in ((1, -math.log(2.0)), (2, math.log(2.0))):
+            got = rot.T @ torch.tensor([[cols[0][0, k], cols[2][0, k]], [cols[2][0, k], cols[1][0, k]]], dtype=F64) @ rot
+            assert torch.allclose(got[0, 0], view[0, 0] * math.exp(ell), rtol=1e-12)
+            assert torch.allclose(got[1, 1], view[1, 1], rtol=1e-12)
+            assert torch.allclose(got[0, 1], view[0, 1] * math.exp(ell / 2), rtol=1e-12)
+            assert float(cols[3][0, k]) == 0.03 and float(cols[4][0, k]) == -0.01
+
+
+@pytest.mark.parametrize("th_deg", [80.0, 86.0, 88.0])
+@pytest.mark.parametrize("ph", [0.0, 0.7, math.pi / 2])
+def test_log_variance_quadratic_predicts_the_model_between_its_nodes(th_deg, ph):
+    """R(ℓ) ≈ R̄ + b ℓ + c ℓ², b and c through the model at the along-view unresolved variance halved and doubled
+    (ℓ = ∓ln 2), against the model itself (``apparent_radiance``, the multi-scale masking, LWIR, midlatitude-
+    summer sky) with that variance scaled by e^ℓ, relative to the change at the nodes, max(|R(±ln 2) − R̄|):
+    between the nodes (ℓ = −0.5, 0.3) within 10 % (measured ≤ 5.8 %), extrapolated to ℓ = −1 and 0.9 (the
+    renderer clamps |ℓ| at ln 3) within 35 % (measured ≤ 28 %, at ℓ = −1). Planted, c off by 1/ln 2: 10–21 %
+    between the nodes and up to 108 % beyond at 86–88°, and the test fails there."""
+    sky = load_sky("midlatitude_summer", LWIR, dtype=F64)
+    m = band_refractive_index(LWIR, 290.0).to(torch.complex128)
+    rb = band_radiance(torch.tensor(290.0, dtype=F64), LWIR)
+    th = torch.tensor(math.radians(th_deg), dtype=F64)
+
+    def model(var_u, var_c, cov):
+        st = SlopeStatistics.from_variances(var_u, var_c, cov).shifted(0.03, -0.01)
+        return apparent_radiance(th, torch.tensor(ph, dtype=F64), st, m, rb, sky, shadowing="multiscale")
+
+    moments = [torch.tensor([[x]], dtype=F64) for x in (0.012, 0.008, 0.001, 0.03, -0.01)]
+    cols = variance_columns(moments, torch.tensor([ph], dtype=F64), 1)
+    r = model(cols[0][0], cols[1][0], cols[2][0])
+    b, c = log_variance_quadratic(r[1], r[0], r[2])
+    scale = float(torch.maximum((r[1] - r[0]).abs(), (r[2] - r[0]).abs()))
+    rot = torch.tensor([[math.cos(ph), -math.sin(ph)], [math.sin(ph), math.cos(ph)]], dtype=F64)
+    view = rot.T @ torch.tensor([[0.012, 0.001], [0.001, 0.008]], dtype=F64) @ rot
+    for ell, tol in ((-1.0, 0.35), (-0.5, 0.1), (0.3, 0.1), (0.9, 0.35)):
+        a = torch.diag(torch.tensor([math.exp(ell / 2), 1.0], dtype=F64))
+        world = rot @ (a @ view @ a) @ rot.T
+        direct = model(world[0, 0], world[1, 1], world[0, 1])
+        assert abs(float(r[0] + b * ell + c * ell * ell - direct)) < tol * scale, (ell, scale)
+
+
+def test_weighted_window_is_the_weighted_mean_over_the_covered_window():
+    """A pixel's texture with the patch moments: the samples' values x weighted by w, averaged over the part of
+    its depression window the sweep covers, times that part. On a synthetic track (every element visible:
+    the running minimum strictly decreasing; an element takes the mean of its two samples), a window whose
+    edges fall on samples, wholly inside the sweep and reaching beyond its end: ``weighted_window`` of the
+    window averages of w x, w and 1 equals the weighted mean computed element by element here, times the
+    covered share, to 1e-12. Planted, the division by ⟨w⟩ left out (what w ≈ 1 on average hides): fails."""
+    from roughsea_torch.renderer.hits import visible_average
+    from roughsea_torch.renderer.lean import weighted_window
+    g = torch.Generator().manual_seed(2)
+    ns = 40
+    m = torch.linspace(0.2, 0.05, ns, dtype=F64)[None]  # (1 track, ns), strictly decreasing: all visible
+    x = torch.randn(ns, generator=g, dtype=F64)
+    w = 0.2 + 2.0 * torch.rand(ns, generator=g, dtype=F64)
+    values = torch.stack([w * x, w, torch.ones_like(w)])[:, None]  # (3, 1, ns)
+    for k0, k1 in ((5, 17), (30, 39)):  # window [m[k1], m[k0]] inside; then one running past the sweep's end
+        top, bottom = m[0, k1], m[0, k0]  # (the upper edge: the lesser depression, farther along the track)
+        if k1 == 39:
+            top = m[0, -1] - 0.02  # beyond the last sample: uncovered
+        avg = visible_average(m, values, torch.zeros(1, dtype=torch.long), top[None], bottom[None])
+        got = weighted_window(avg[0], avg[1], avg[2])
+        e = torch.arange(k0, min(k1, ns - 1))
+        span = m[0, e] - m[0, e + 1]
+        el = lambda v: 0.5 * (v[e] + v[e + 1])  # noqa: E731
+        want = (span * el(w * x)).sum() / (span * el(w)).sum() * span.sum() / (bottom - top)
+        assert abs(float(got[0] - want)) < 1e-12, (float(got[0]), float(want))
