@@ -10,7 +10,7 @@ timed in turn within one loop (so the machine's load falls on all of them), medi
 with 1 and 2 torch threads. ``--baseline DIR``: a checkout (e.g. ``git archive main roughsea_torch | tar -x
 -C DIR``) whose ``roughsea_torch`` is loaded beside this one under another name and timed as
 "first-hit, baseline". Variants: ``TableSize`` fields of approximate sweeps and the sweep with the unresolved
-waves' patch moments (``texture_hit_lean``), timed as well.
+waves' patch moments (``texture_hit_lean``), alone and on sweeps with ``texture_hit_across`` 1, 2 and 3, timed as well.
 
 Then, 1 thread, where the first-hit render's time goes (each stage timed around its call, the rest of
 the render left to "other"), and the sweep's size: samples per track, tracks, samples per pixel, the
@@ -53,7 +53,10 @@ CAMERAS = {"15 m, −6°": CAMERA, "20 m, −2°": FAR_CAMERA}
 VARIANTS = {"first-hit, across 2": dict(texture_hit_across=2.0),
             "first-hit, min_step 1/16": dict(texture_hit_min_step=0.0625),
             "first-hit, across 2, min_step 1/16": dict(texture_hit_across=2.0, texture_hit_min_step=0.0625),
-            "first-hit, patch moments (texture_hit_lean)": dict(texture_hit_lean=True)}
+            "first-hit, patch moments (texture_hit_lean)": dict(texture_hit_lean=True),
+            "first-hit, across 1, patch moments": dict(texture_hit_across=1.0, texture_hit_lean=True),
+            "first-hit, across 2, patch moments": dict(texture_hit_across=2.0, texture_hit_lean=True),
+            "first-hit, across 3, patch moments": dict(texture_hit_across=3.0, texture_hit_lean=True)}
 
 
 def load_baseline(path: str):
