@@ -134,6 +134,9 @@ class ShortWaveMoments:
         const = [zero_r, zero_r, zero_r]  # the same, per row, of the bands whose patches hold 4 wavelengths or more
         expected = [zero_r, zero_r, zero_r]  # Σ u² C_o per row
         nl = len(LEVELS)
+        xy = torch.stack([x, y], -1)  # (P, 2)
+        graph = torch.is_grad_enabled() and any(t.requires_grad for t in (x, y, footprint, patch, self._band_slopes()))
+        acc = None if graph else x.new_zeros((5,) + x.shape, dtype=dtype)  # μ_x, μ_y, then the covariance's three
         for o, k_o in enumerate(self.k):
             if not self.on[o]:
                 continue
@@ -157,11 +160,13 @@ class ShortWaveMoments:
                 at = flat_index((near_rows & (i0 == lv)).index_select(0, row))
                 if at.numel() == 0:
                     continue
-                ra = row.index_select(0, at)
+                a0, a1 = int(at[0]), int(at[-1]) + 1
+                span = slice(a0, a1) if a1 - a0 == at.numel() else None  # (points in sweep order: a level's run)
+                pick = (lambda v: v[span]) if span is not None else (lambda v: v.index_select(0, at))  # noqa: E731
+                ra = pick(row)
                 t = jc.index_select(0, ra) - float(lv)
-                xs, ys, us = x.index_select(0, at), y.index_select(0, at), u.index_select(0, ra)
-                g = torch.stack([torch.remainder(xs / self.length[o], 1.0), torch.remainder(ys / self.length[o], 1.0)], -1)
-                grid = (2.0 * g - 1.0).to(dtype)[None, None]  # (1, 1, P', 2)
+                us = u.index_select(0, ra)
+                grid = torch.remainder(pick(xy) * (1.0 / self.length[o]), 1.0).mul_(2.0).sub_(1.0).to(dtype)[None, None]
                 pair = lev[lv:lv + 2].reshape(1, -1, *lev.shape[-2:])  # (1, 10 or 5, N + 1, N + 1)
                 read = F.grid_sample(pair, grid, mode="bilinear", padding_mode="border", align_corners=True)[0, :, 0]
                 lo = read[:5]
@@ -171,9 +176,17 @@ class ShortWaveMoments:
                     hi = torch.cat([torch.zeros_like(lo[:2]), cov_o[:, None].to(lo.dtype).expand(3, lo.shape[1])])
                 m = lo + (hi - lo) * t.clamp(0.0, 1.0)[None]
                 us2 = us * us
-                mu = [mu[0].index_add(0, at, us * m[0]), mu[1].index_add(0, at, us * m[1])]
-                cov = (m[2] - m[0] * m[0], m[3] - m[1] * m[1], m[4] - m[0] * m[1])
-                second = [s_.index_add(0, at, us2 * c_) for s_, c_ in zip(second, cov)]
+                parts = (us * m[0], us * m[1], us2 * (m[2] - m[0] * m[0]), us2 * (m[3] - m[1] * m[1]),
+                         us2 * (m[4] - m[0] * m[1]))
+                if acc is not None and span is not None:  # (in place on our own buffer: nothing needs a graph)
+                    acc[:, span] += torch.stack(parts)
+                elif acc is not None:
+                    acc.index_add_(1, at, torch.stack(parts))
+                else:
+                    mu = [mu[0].index_add(0, at, parts[0]), mu[1].index_add(0, at, parts[1])]
+                    second = [s_.index_add(0, at, c_) for s_, c_ in zip(second, parts[2:])]
+        if acc is not None:
+            mu, second = [acc[0], acc[1]], [acc[2], acc[3], acc[4]]
         second = [s_ + c_.index_select(0, row) for s_, c_ in zip(second, const)]
         return (*mu, *second, *(e.index_select(0, row) for e in expected))
 
