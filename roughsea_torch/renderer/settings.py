@@ -223,6 +223,9 @@ class TableSize:
         for name in ("texture_hit_cross", "texture_hit_lean"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise ValueError(f"TableSize.{name} must be a bool; got {getattr(self, name)!r}")
+        if self.texture_hit_lean and self.texture_hit != "first":
+            raise ValueError("TableSize.texture_hit_lean=True needs texture_hit='first' (the patch moments are read at the "
+                             f"first-hit sweep's samples); got texture_hit={self.texture_hit!r}")
         if not isinstance(self.foam_trails, (bool, np.bool_)):
             raise ValueError(f"TableSize.foam_trails must be a bool; got {self.foam_trails!r}")
         if not isinstance(self.glitter, (bool, np.bool_)):
