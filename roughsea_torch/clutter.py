@@ -52,7 +52,7 @@ import torch
 from .slopes import SlopeStatistics
 
 __all__ = ["visible_slope", "unresolved_statistics", "two_scale_statistics", "pixel_resolved_slope", "resolved_quantile",
-           "along_view", "view_moments", "footprint",
+           "along_view", "along_variance", "view_moments", "footprint",
            "reconcile_scale"]
 
 _SQRT_HALF = math.sqrt(0.5)
@@ -174,13 +174,20 @@ def two_scale_statistics(
     return (stats, ap / sig_a[e]) if return_visible else stats
 
 
+def along_variance(cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], ex: torch.Tensor, ey: torch.Tensor
+                   ) -> torch.Tensor:
+    """σ_a²: the variance along the unit vector ê = (ex, ey) of slopes of covariance ``cov`` = (var_x, var_y,
+    cov_xy) in the same frame (world or upwind)."""
+    cxx, cyy, cxy = cov
+    return cxx * ex * ex + 2.0 * cxy * ex * ey + cyy * ey * ey
+
+
 def _along(cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], ex: torch.Tensor, ey: torch.Tensor
            ) -> tuple[torch.Tensor, torch.Tensor]:
     """(σ_a², c_a⊥): the variance along ê = (ex, ey) of a slope field of covariance ``cov`` = (var_x,
     var_y, cov_xy), and the covariance of its components along ê and ê⊥ (ê turned +90°)."""
     cxx, cyy, cxy = cov
-    return (cxx * ex * ex + 2.0 * cxy * ex * ey + cyy * ey * ey,
-            (cyy - cxx) * ex * ey + cxy * (ex * ex - ey * ey))
+    return along_variance(cov, ex, ey), (cyy - cxx) * ex * ey + cxy * (ex * ex - ey * ey)
 
 
 def view_moments(cov: tuple[torch.Tensor, torch.Tensor, torch.Tensor], ex: torch.Tensor, ey: torch.Tensor

@@ -33,7 +33,7 @@ import torch
 from ._validation import as_tensor, check_finite_range, resolve_dtype_device
 from .slopes import SlopeStatistics
 
-__all__ = ["FacetGeometry", "facet_geometry", "denominator", "prepare_inputs", "normal_pdf", "normal_cdf", "visible_ratio"]
+__all__ = ["FacetGeometry", "facet_geometry", "denominator", "eq5_denominator", "prepare_inputs", "normal_pdf", "normal_cdf", "visible_ratio"]
 
 _INV_SQRT_2PI = 1.0 / math.sqrt(2.0 * math.pi)
 _SQRT_HALF = math.sqrt(0.5)
@@ -128,7 +128,11 @@ def denominator(g: FacetGeometry, shadowing: bool) -> torch.Tensor:
     e = g.ct + g.st * g.mu
     if not shadowing:
         return e
-    a = g.st * g.su
+    return eq5_denominator(e, g.st * g.su)
+
+
+def eq5_denominator(e: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
+    """Eq. 5's D = e Φ(e/a) + a φ(e/a) from e = cos θ̂ + sin θ̂ m∥ and a = sin θ̂ σ∥ (:func:`denominator`)."""
     big = e > 40.0 * a  # μ > 40: Φ(μ) = 1, φ(μ) = 0 to every precision
     mu = e / torch.where(big, torch.ones_like(a), a)
     mu = torch.where(big, torch.full_like(mu, 40.0), mu)

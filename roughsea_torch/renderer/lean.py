@@ -47,7 +47,7 @@ from typing import Any
 import torch
 import torch.nn.functional as F
 
-from ..facets import normal_cdf, normal_pdf
+from ..facets import eq5_denominator
 from ..wave_bands import band_window
 
 __all__ = ["ShortWaveMoments", "variance_columns", "log_variance_quadratic", "projected_area",
@@ -68,8 +68,8 @@ class ShortWaveMoments:
         time_s: the times of the field's images [s], a (B,) float64 tensor.
 
     Call it with world points x, y (P,) [m], their footprints (the resolved cut F_s [m]) and patch sizes p
-    [m] (P,), or per row (R,) with each point's row (P,): (μ_x, μ_y, C_xx, C_yy, C_xy, V_xx, V_yy, V_xy), each (P,), world-frame slopes
-    (dimensionless): the patch mean μ and covariance C of the unresolved slopes, and V = Σ_o u_o² C_o their
+    [m] (P,), or per row (R,) with each point's row (P,): (μ_x, μ_y, C_xx, C_yy, C_xy, V_xx, V_yy, V_xy), each
+    (P,), world-frame slopes (dimensionless): the patch mean μ and covariance C of the unresolved slopes, and V = Σ_o u_o² C_o their
     expected total (μμᵀ + C averages to V over positions; C_o the band's covariance on its tile's texels,
     :meth:`band_moments`).
     """
@@ -110,13 +110,14 @@ class ShortWaveMoments:
                 out.append(torch.fft.irfft2(spec * torch.exp(-0.5 * sig * sig * k2), s=(n, n)))
             lev = torch.stack(out)  # (L, 5, N, N)
             self._levels[o] = F.pad(lev, (0, 1, 0, 1), mode="circular")
-            self._means[o] = fields[2:].mean(dim=(-2, -1))  # (3,): the band's covariance on its texels
         return self._levels[o]
 
     def band_moments(self, o: int) -> torch.Tensor:
         """C_o = (var_x, var_y, cov_xy) of band ``o``'s slopes, the mean of their products over its tile's
         texels (what every level averages to over positions)."""
-        self.levels(o)
+        if o not in self._means:
+            s = self._band_slopes()[o]
+            self._means[o] = torch.stack([s[0] * s[0], s[1] * s[1], s[0] * s[1]]).mean(dim=(-2, -1))
         return self._means[o]
 
     def __call__(self, x: torch.Tensor, y: torch.Tensor, footprint: torch.Tensor, patch: torch.Tensor,
@@ -128,15 +129,14 @@ class ShortWaveMoments:
         if row is None:
             row = torch.arange(x.shape[0], device=x.device)
         n_rows = footprint.shape[0]
-        zero_p, zero_r = x.new_zeros(x.shape, dtype=dtype), footprint.new_zeros((n_rows,), dtype=dtype)
-        mu = [zero_p, zero_p]
-        second = [zero_p, zero_p, zero_p]  # Σ u² (⟨s sᵀ⟩ − ⟨s⟩⟨s⟩ᵀ) at the points read
+        zero_r = footprint.new_zeros((n_rows,), dtype=dtype)
         const = [zero_r, zero_r, zero_r]  # the same, per row, of the bands whose patches hold 4 wavelengths or more
         expected = [zero_r, zero_r, zero_r]  # Σ u² C_o per row
         nl = len(LEVELS)
         xy = torch.stack([x, y], -1)  # (P, 2)
         graph = torch.is_grad_enabled() and any(t.requires_grad for t in (x, y, footprint, patch, self._band_slopes()))
-        acc = None if graph else x.new_zeros((5,) + x.shape, dtype=dtype)  # μ_x, μ_y, then the covariance's three
+        # μ_x, μ_y and Σ u² (⟨s sᵀ⟩ − ⟨s⟩⟨s⟩ᵀ) (three) at the points read; in place where no graph is kept
+        acc = x.new_zeros((5,) + x.shape, dtype=dtype)
         for o, k_o in enumerate(self.k):
             if not self.on[o]:
                 continue
@@ -176,19 +176,16 @@ class ShortWaveMoments:
                     hi = torch.cat([torch.zeros_like(lo[:2]), cov_o[:, None].to(lo.dtype).expand(3, lo.shape[1])])
                 m = lo + (hi - lo) * t.clamp(0.0, 1.0)[None]
                 us2 = us * us
-                parts = (us * m[0], us * m[1], us2 * (m[2] - m[0] * m[0]), us2 * (m[3] - m[1] * m[1]),
-                         us2 * (m[4] - m[0] * m[1]))
-                if acc is not None and span is not None:  # (in place on our own buffer: nothing needs a graph)
-                    acc[:, span] += torch.stack(parts)
-                elif acc is not None:
-                    acc.index_add_(1, at, torch.stack(parts))
+                parts = torch.stack((us * m[0], us * m[1], us2 * (m[2] - m[0] * m[0]), us2 * (m[3] - m[1] * m[1]),
+                                     us2 * (m[4] - m[0] * m[1])))
+                if graph:
+                    acc = acc.index_add(1, at, parts)
+                elif span is not None:
+                    acc[:, span] += parts
                 else:
-                    mu = [mu[0].index_add(0, at, parts[0]), mu[1].index_add(0, at, parts[1])]
-                    second = [s_.index_add(0, at, c_) for s_, c_ in zip(second, parts[2:])]
-        if acc is not None:
-            mu, second = [acc[0], acc[1]], [acc[2], acc[3], acc[4]]
-        second = [s_ + c_.index_select(0, row) for s_, c_ in zip(second, const)]
-        return (*mu, *second, *(e.index_select(0, row) for e in expected))
+                    acc.index_add_(1, at, parts)
+        return (acc[0], acc[1], *(acc[2 + c] + const[c].index_select(0, row) for c in range(3)),
+                *(e.index_select(0, row) for e in expected))
 
 
 def variance_columns(moments: list, ph: torch.Tensor, nx: int) -> list:
@@ -210,7 +207,8 @@ def variance_columns(moments: list, ph: torch.Tensor, nx: int) -> list:
     return out + [torch.cat([m, mean, mean], 1) for m, mean in zip(moments[3:], (mu, mc))]
 
 
-def log_variance_quadratic(r_minus: torch.Tensor, r_bar: torch.Tensor, r_plus: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+def log_variance_quadratic(r_minus: torch.Tensor, r_bar: torch.Tensor, r_plus: torch.Tensor
+                           ) -> tuple[torch.Tensor, torch.Tensor]:
     """(b, c) of R(ℓ) ≈ R̄ + b ℓ + c ℓ² through the node values at ℓ = −ln 2, 0, ln 2 (``r_minus``, ``r_bar``,
     ``r_plus``: the along-view unresolved variance halved, as it is, doubled; :func:`variance_columns`)."""
     return (r_plus - r_minus) / (2.0 * ELL_NODE), (0.5 * (r_plus + r_minus) - r_bar) / (ELL_NODE * ELL_NODE)
@@ -226,10 +224,9 @@ def weighted_window(wx: torch.Tensor, w: torch.Tensor, covered: torch.Tensor) ->
 
 
 def projected_area(e: torch.Tensor, a: torch.Tensor) -> torch.Tensor:
-    """Eq. 5's D = e Φ(e/a) + a φ(e/a) (:func:`~roughsea_torch.facets.denominator`) from e = cos θ̂ + sin θ̂ m∥
-    and a = sin θ̂ σ∥, floored at the smallest normal number."""
-    z = e / a.clamp_min(1e-30)
-    return (e * normal_cdf(z) + a * normal_pdf(z)).clamp_min(torch.finfo(e.dtype).tiny)
+    """Eq. 5's D (:func:`~roughsea_torch.facets.eq5_denominator`) from e = cos θ̂ + sin θ̂ m∥ and a = sin θ̂ σ∥,
+    floored at the smallest normal number (a weight's denominator)."""
+    return eq5_denominator(e, a).clamp_min(torch.finfo(e.dtype).tiny)
 
 
 def flat_index(mask: torch.Tensor) -> torch.Tensor:

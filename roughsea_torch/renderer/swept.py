@@ -18,7 +18,7 @@ from typing import Any
 import torch
 
 from .._parallel import BLOCK, in_blocks
-from ..clutter import footprint, reconcile_scale, resolved_quantile, view_moments
+from ..clutter import along_variance, footprint, reconcile_scale, resolved_quantile, view_moments
 from ..geometry import slant_range
 from ..whitecaps import whitecap_cover
 from .hits import (Sweep, covers, flat_nonzero, footprint_fade, nonzero_2d, pixel_hits, pixel_windows, read_at,
@@ -167,30 +167,25 @@ class SweptTexture:
                                    cos_k) if self.lean else None)
         n_cross = 2 + 2 * self.lean  # the cross channels' distance from the volume's end
 
-        def value(u: int, e: int, s_x: torch.Tensor, s_y: torch.Tensor, ell: torch.Tensor | None) -> tuple:
+        def block(u: int, e: int) -> tuple:  # the texture at the read samples u:e, and x of their resolved slope
             r_, c_ = row[u:e], col[u:e]
+            s_x, s_y = smp["slope_x"][0, u:e], smp["slope_y"][0, u:e]
             cov_v, cx_v, sx_v = tuple(pick(c, r_) for c in cov_k), pick(cx, c_), pick(sx, c_)
-            x_v = resolved_quantile(s_x, s_y, cov_v, cx_v, sx_v)
-            read = self._read_volume(vol[i:i + 1], x_v[None, None], pick(o_t, c_)[None, None], pick(gy_k, r_)[None, None],
+            x_v = resolved_quantile(s_x, s_y, cov_v, cx_v, sx_v)  # (for the glint: the resolved slope alone)
+            if lean is not None:  # the unresolved waves' mean slope over the sample's patch added
+                s_x, s_y = s_x + lean[0][u:e], s_y + lean[1][u:e]
+            x_t = x_v if lean is None else resolved_quantile(s_x, s_y, cov_v, cx_v, sx_v)
+            read = self._read_volume(vol[i:i + 1], x_t[None, None], pick(o_t, c_)[None, None], pick(gy_k, r_)[None, None],
                                      a[i:i + 1], b[i:i + 1])[0, :, 0]  # (C, e − u)
             out = read[0]
-            if ell is not None:  # + b ℓ + c ℓ², ℓ the log of the along-view unresolved variance's scale
+            if lean is not None:  # + b ℓ + c ℓ², ℓ the log of the along-view unresolved variance's scale
+                ell = lean[2][u:e]
                 out = out + read[-2] * ell + read[-1] * (ell * ell)
             if not self.cross:
                 return out, x_v
             # + g y + h (y² − 1), y the across-view residual of the resolved slope over its rms
-            y = _across_quantile(s_x, s_y, cov_v, cx_v, sx_v, x_v)
+            y = _across_quantile(s_x, s_y, cov_v, cx_v, sx_v, x_t)
             return out + read[-n_cross] * y + read[-n_cross + 1] * (y * y - 1.0), x_v
-
-        def block(u: int, e: int) -> tuple:  # the texture and x at the read samples u:e
-            s_x, s_y = smp["slope_x"][0, u:e], smp["slope_y"][0, u:e]
-            if lean is None:
-                return value(u, e, s_x, s_y, None)
-            # the unresolved waves' mean slope over the sample's patch added, their along-view variance scaled;
-            # x (for the glint) of the resolved slope alone
-            out, _ = value(u, e, s_x + lean[0][u:e], s_y + lean[1][u:e], lean[2][u:e])
-            r_, c_ = row[u:e], col[u:e]
-            return out, resolved_quantile(s_x, s_y, tuple(pick(c, r_) for c in cov_k), pick(cx, c_), pick(sx, c_))
 
         grad = torch.is_grad_enabled() and any(v.requires_grad for v in (vol, smp["slope_x"], cov_k[0], gy_k, o_t, a, b)
                                                + (() if lean is None else lean))
@@ -235,17 +230,16 @@ class SweptTexture:
         patch = torch.sqrt(self.lean_across * rho * self.ifov[im] * 0.5 * sw.footprint)
         mx, my, cxx, cyy, cxy, vxx, vyy, vxy = ShortWaveMoments(wf, 0, self.time[im:im + 1])(x, y, fpk, patch, row)
         ex, ey = pick(torch.cos(sw.az), col), pick(torch.sin(sw.az), col)
-        along = lambda c0, c1, c2: c0 * ex * ex + 2.0 * c2 * ex * ey + c1 * ey * ey  # noqa: E731
         lam = reconcile_scale(cov_k, p.vx[im], p.vy[im], p.cxy[im], p.wind_direction[im])  # (ns,)
         lam2 = pick(lam * lam, row)
         wd = p.wind_direction[im].to(self.dtype)
         cr, sr = pick(torch.cos(sw.az - wd), col), pick(torch.sin(sw.az - wd), col)
-        total = p.vx[im] * cr * cr + 2.0 * p.cxy[im] * cr * sr + p.vy[im] * sr * sr
-        v_u = (total - lam2 * along(*(pick(c, row) for c in cov_k))).clamp_min(1e-12)
-        v_f = along(vxx, vyy, vxy)
+        total = along_variance((p.vx[im], p.vy[im], p.cxy[im]), cr, sr)  # (upwind frame, relative azimuth)
+        v_u = (total - lam2 * along_variance(tuple(pick(c, row) for c in cov_k), ex, ey)).clamp_min(1e-12)
+        v_f = along_variance((vxx, vyy, vxy), ex, ey)
         kappa2 = lam2 * torch.clamp(v_u / (lam2 * v_f).clamp_min(1e-30), max=1.0)
         kappa = kappa2.sqrt()
-        delta = kappa2 * (along(cxx, cyy, cxy) - v_f)
+        delta = kappa2 * (along_variance((cxx, cyy, cxy), ex, ey) - v_f)
         ell = torch.log((v_u + delta).clamp_min(v_u * math.exp(-ELL_CLAMP)) / v_u).clamp(-ELL_CLAMP, ELL_CLAMP)
         # the patch's visible projected area (Eq. 5's D about the along-view mean and rms) over the node's
         lam = pick(lam, row)
@@ -253,7 +247,8 @@ class SweptTexture:
         mu_a = -(mx * ex + my * ey) * kappa
         ct = pick(cos_k, row)
         st = torch.sqrt((1.0 - ct * ct).clamp_min(0.0))
-        w = projected_area(ct + st * (a_r + mu_a), st * torch.sqrt(v_u * torch.exp(ell))) / projected_area(ct + st * a_r, st * v_u.sqrt())
+        w = (projected_area(ct + st * (a_r + mu_a), st * torch.sqrt(v_u * torch.exp(ell)))
+             / projected_area(ct + st * a_r, st * v_u.sqrt()))
         # the shift of the field's slope that moves the model's (λ times it, the volume's x = a/σ_a of the raw
         # slope, docs/texture.md §7) by κ μ
         shift = kappa / lam

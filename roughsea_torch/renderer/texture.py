@@ -21,7 +21,8 @@ import torch
 import torch.nn.functional as F
 
 from .._validation import per_batch
-from ..clutter import along_view, footprint, reconcile_scale, resolved_quantile, two_scale_statistics, view_moments
+from ..clutter import (along_variance, along_view, footprint, reconcile_scale, resolved_quantile, two_scale_statistics,
+                       view_moments)
 from ..expectation import reflection_terms
 from ..geometry import slant_range
 from ..sky import ConstantSky, TabulatedSky, select_sky
@@ -201,7 +202,7 @@ class TextureTable(SweptTexture):
         var_a, kap = along_view(cov, torch.cos(phw)[:, None, :], torch.sin(phw)[:, None, :])  # (b, nz, nphi)
         vx, vy, cxy = (getattr(p, k)[sl, None, None] for k in ("vx", "vy", "cxy"))
         c, s = torch.cos(ph_nodes)[:, None, :], torch.sin(ph_nodes)[:, None, :]
-        suu = vx * c * c + 2.0 * cxy * c * s + vy * s * s
+        suu = along_variance((vx, vy, cxy), c, s)
         active = (var_a > 1e-10 * suu).expand(b_, nz, nphi)
         if not bool(active.any()):
             return None
