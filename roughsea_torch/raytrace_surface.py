@@ -131,7 +131,9 @@ class TracedSurface:
         xs, ys, fs = [], [], []
         for o in range(self.n_traced):
             h = field.bands.tile_length[o] / n
-            gx, gy = torch.meshgrid(idx * h, idx * h, indexing="xy")  # (n, n): row j = y, column i = x
+            gu, gv = torch.meshgrid(idx * h, idx * h, indexing="xy")  # (n, n): row j = v, column i = u (tile axes)
+            ca, sa = math.cos(field.bands.tile_angle[o]), math.sin(field.bands.tile_angle[o])
+            gx, gy = gu * ca - gv * sa, gu * sa + gv * ca  # the texels in the world
             for last in (o, o - 1):  # the same nodes with bands ≤ o and with bands ≤ o − 1
                 xs.append(gx.reshape(-1))
                 ys.append(gy.reshape(-1))
@@ -171,19 +173,20 @@ class TracedSurface:
         return margin(etas), margin(lips)
 
     def _lookup(self, tiles: list[torch.Tensor], x: torch.Tensor, y: torch.Tensor) -> list[torch.Tensor]:
-        """Each band's bilinear interpolation at (x mod L_o, y mod L_o): a (B, C, P) tensor per band."""
+        """Each band's bilinear interpolation at (u mod L_o, v mod L_o), (u, v) the point in the tile's turned axes
+        (``WaveBands.tile_units``): a (B, C, P) tensor per band."""
         xy = torch.stack([x, y], -1)[:, None]  # (B, 1, P, 2)
         out = []
         for o, tile in enumerate(tiles):
-            grid = xy * (2.0 / self.field.bands.tile_length[o])
-            grid = torch.remainder(grid, 2.0, out=grid).sub_(1.0)  # (x mod L) / L mapped to [−1, 1)
+            grid = self.field.bands.tile_units(o, xy) * 2.0
+            grid = torch.remainder(grid, 2.0, out=grid).sub_(1.0)  # (u mod L) / L mapped to [−1, 1)
             out.append(torch.nn.functional.grid_sample(tile, grid, mode="bilinear", padding_mode="border",
                                                        align_corners=True)[:, :, 0])
         return out
 
     def __call__(self, x: torch.Tensor, y: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """(η [m], s_x, s_y) of the traced bands at world points x, y (B, P) [m]: the bilinear
-        interpolation of each band's tile at (x mod L_o, y mod L_o), summed over the traced bands
+        interpolation of each band's tile at (u mod L_o, v mod L_o), summed over the traced bands
         (what ``field.sample`` returns, to rounding: ``tests/test_raytrace.py``)."""
         if self.n_traced == 0:
             z = torch.zeros_like(x)

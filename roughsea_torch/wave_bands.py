@@ -17,7 +17,9 @@ from numbers import Integral
 
 import torch
 
-__all__ = ["WaveBands", "WINDOW_LO", "WINDOW_HI", "band_window"]
+__all__ = ["WaveBands", "WINDOW_LO", "WINDOW_HI", "GOLDEN_ANGLE", "band_window"]
+
+GOLDEN_ANGLE = math.pi * (3.0 - math.sqrt(5.0))  # [rad] 137.5°: band o's tile is turned by o times this
 
 
 @dataclass(frozen=True)
@@ -34,6 +36,13 @@ class WaveBands:
           fully developed sea peaks at 363 m, 30 m s⁻¹ at 816 m).
         - ``inner_radius`` = 4: an octave band holds the lattice points 4 ≤ |k|/Δk < 8, about
           π (8² − 4²) ≈ 150 modes (75 independent complex amplitudes and their conjugates).
+        - ``tile_rotation`` = the golden angle π(3 − √5) ≈ 137.5°: band o's tile is turned by o times it
+          about the vertical (``tile_angle``). Without it every tile is aligned with the world's x and y
+          axes and, the lengths halving, the short bands repeat *together*: their sum repeats exactly
+          every few metres along x and y, which a camera looking along an axis sees as dotted
+          streaks. Turned by multiples of an angle that is an irrational fraction of a turn, no two
+          bands share a lattice direction, so no direction repeats more than one band's pattern.
+          ``tile_rotation=0`` gives the aligned tiles (the realizations made before 2026-11-27).
         - ``tile_size`` = 128: the highest mode of a band is 8 Δk = 2π/16 per texel, 16 texels per
           wavelength. Bilinear interpolation (see :class:`~roughsea_torch.waves.WaveField`) then
           keeps, averaged over positions, a fraction (2 + cos θx)(2 + cos θy)/9 of a mode's variance
@@ -41,8 +50,11 @@ class WaveBands:
           includes that factor exactly. A band's tile costs (N + 1)² × 3 channels × 4 bytes = 0.2 MB
           in float32, 3.2 MB for the 16 bands.
 
-    Tile lengths differ from band to band (L_o = 6434 m … 0.196 m by halves), so no pattern repeats
-    across bands; a single band repeats with its own period of 4–8 of its wavelengths.
+    Tile lengths differ from band to band (L_o = 6434 m … 0.196 m by halves) and the tiles are turned
+    by different angles, so no pattern repeats across bands; a single band repeats with its own period
+    of 4–8 of its wavelengths along its tile's axes. A tile's texel (row i, column j) lies at tile
+    coordinates (v, u) = (i, j) L_o / N, i.e. at world x = u cos α_o − v sin α_o, y = u sin α_o +
+    v cos α_o (α_o = ``tile_angle[o]``); :meth:`tile_units` maps world points to tile periods.
 
     Example:
         >>> b = WaveBands()
@@ -53,6 +65,7 @@ class WaveBands:
     k_edges: tuple[float, ...] = tuple(2.0**e for e in range(-8, 9))
     tile_size: int = 128
     inner_radius: float = 4.0
+    tile_rotation: float = GOLDEN_ANGLE
 
     def __post_init__(self) -> None:
         edges = tuple(float(e) for e in self.k_edges)
@@ -68,6 +81,10 @@ class WaveBands:
         object.__setattr__(self, "tile_size", int(self.tile_size))
         if not (math.isfinite(self.inner_radius) and self.inner_radius > 0):
             raise ValueError(f"inner_radius must be finite and > 0 fundamentals; got {self.inner_radius!r}")
+        if isinstance(self.tile_rotation, bool) or not isinstance(self.tile_rotation, (int, float)) \
+                or not math.isfinite(self.tile_rotation) or abs(self.tile_rotation) > 2.0 * math.pi:
+            raise ValueError(f"tile_rotation must be a finite angle in [-2π, 2π] rad; got {self.tile_rotation!r}")
+        object.__setattr__(self, "tile_rotation", float(self.tile_rotation))
         for o in range(self.n_bands):
             outer = self.inner_radius * edges[o + 1] / edges[o]
             if outer > self.tile_size / 4:
@@ -78,9 +95,11 @@ class WaveBands:
                 )
 
     @classmethod
-    def octaves(cls, k_min: float, n_bands: int, *, tile_size: int = 128, inner_radius: float = 4.0) -> WaveBands:
+    def octaves(cls, k_min: float, n_bands: int, *, tile_size: int = 128, inner_radius: float = 4.0,
+                tile_rotation: float = GOLDEN_ANGLE) -> WaveBands:
         """``n_bands`` octave bands starting at ``k_min`` [rad m⁻¹]."""
-        return cls(tuple(float(k_min) * 2.0**o for o in range(int(n_bands) + 1)), tile_size, inner_radius)
+        return cls(tuple(float(k_min) * 2.0**o for o in range(int(n_bands) + 1)), tile_size, inner_radius,
+                   tile_rotation)
 
     @property
     def n_bands(self) -> int:
@@ -100,6 +119,24 @@ class WaveBands:
     def tile_length(self) -> tuple[float, ...]:
         """L_o = 2π/Δk_o, the period of each band's tile [m]."""
         return tuple(2.0 * math.pi / dk for dk in self.fundamental)
+
+    @property
+    def tile_angle(self) -> tuple[float, ...]:
+        """α_o = o · ``tile_rotation`` mod 2π, the angle [rad] from the world x axis to band o's tile axis u
+        (counter-clockwise seen from above)."""
+        return tuple(math.remainder(o * self.tile_rotation, 2.0 * math.pi) for o in range(self.n_bands))
+
+    def tile_units(self, o: int, xy: torch.Tensor) -> torch.Tensor:
+        """World points ``xy`` (..., 2) = (x, y) [m] in band ``o``'s tile periods: (u, v) / L_o with u = x cos α_o
+        + y sin α_o, v = −x sin α_o + y cos α_o (``xy / L_o`` exactly for an unturned tile). Whole numbers
+        are the tile's corners; the fractional part is where the periodic tile is read."""
+        length = self.tile_length[o]
+        alpha = self.tile_angle[o]
+        if alpha == 0.0:
+            return xy * (1.0 / length)
+        c, s = math.cos(alpha) / length, math.sin(alpha) / length
+        m = torch.tensor([[c, -s], [s, c]], dtype=xy.dtype, device=xy.device)
+        return torch.matmul(xy, m)
 
     @property
     def max_index(self) -> int:

@@ -36,9 +36,10 @@ class BandLattice:
     """The lattice of every band's modes for a :class:`~roughsea_torch.wave_bands.WaveBands` layout, on
     ``device``, with the inverse-DFT matrices in ``dtype`` (float32 or float64).
 
-    Attributes (per band o, rows i_y = −M..M, columns i_x = 0..M, M = ``max_index``; float64 unless said):
+    Attributes (per band o, rows i_y = −M..M, columns i_x = 0..M along the tile's axes, M = ``max_index``;
+    float64 unless said):
         mask: (n_bands, 2M+1, M+1) bool, the modes of band o's annulus.
-        kx, ky, k: the wavenumber vector and its norm [rad m⁻¹] (k = 1 outside the mask).
+        kx, ky, k: the wavenumber vector in the world frame and its norm [rad m⁻¹] (k = 1 outside the mask).
         dk2: Δk_o² [rad² m⁻²]; omega: ω(k) [rad s⁻¹].
         multiplicity: 2 for i_x > 0 (a mode and its conjugate mirror −k), 1 for i_x = 0.
         interp: the bilinear factor (2 + cos θx)(2 + cos θy)/9 of each mode.
@@ -59,10 +60,14 @@ class BandLattice:
         ratio = torch.tensor([b / a for a, b in zip(bands.k_edges[:-1], bands.k_edges[1:])], dtype=f64).view(-1, 1, 1)
         inner2 = bands.inner_radius**2
         mask = (r2 >= inner2) & (r2 < inner2 * ratio**2)  # (n_bands, 2M+1, M+1)
-        # the half plane: i_x > 0, plus i_x = 0 with both signs of i_y
-        kx = ix * dk
-        ky = iy * dk
-        k = torch.sqrt(kx**2 + ky**2)
+        # the half plane: i_x > 0, plus i_x = 0 with both signs of i_y; the indices count along band o's tile
+        # axes, turned by α_o from the world's (WaveBands.tile_angle): k = Δk_o (i_x û + i_y v̂) in the world
+        # frame, û = (cos α_o, sin α_o), v̂ = (−sin α_o, cos α_o)
+        alpha = torch.tensor(bands.tile_angle, dtype=f64).view(-1, 1, 1)
+        ca, sa = torch.cos(alpha), torch.sin(alpha)
+        kx = (ix * ca - iy * sa) * dk
+        ky = (ix * sa + iy * ca) * dk
+        k = torch.sqrt(r2) * dk  # the same for every turn of the tile
         self.mask = mask.to(dev)
         self.kx = kx.to(dev)
         self.ky = ky.to(dev)

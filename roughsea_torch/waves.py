@@ -84,7 +84,8 @@ class WaveField:
             The renderer uses ``TableSize.texture_min_band_share`` (``docs/notes/wave_field.md``).
 
     Synthesis (Tessendorf 2001, with two changes that make the result exact and one-way):
-        For band o on its tile (length L_o, N × N texels, lattice k = Δk_o (i, j)), every mode of
+        For band o on its tile (length L_o, N × N texels, lattice k = Δk_o (i û_o + j v̂_o) along the
+        tile's axes û_o, v̂_o, turned by α_o = ``bands.tile_angle[o]`` from the world's), every mode of
         the band's annulus gets a complex amplitude H₀(k) = W(k) √(F(k, φ) Δk_o²) where W is
         complex white noise made Hermitian, W(−k) = W(k)*, with E|W|² = 1 (so each real component of
         H₀ has variance F Δk²/2, and ⟨η²⟩ = Σ_k F Δk² exactly, summing over the whole lattice).
@@ -109,7 +110,8 @@ class WaveField:
 
     Evaluation (:meth:`sample`):
         Each band's tile is padded circularly by one texel and sampled bilinearly with
-        ``grid_sample`` (align_corners=True) at (x mod L_o, y mod L_o): all channels (η, s_x, s_y)
+        ``grid_sample`` (align_corners=True) at (u mod L_o, v mod L_o), (u, v) the point in the tile's
+        axes (turned by ``bands.tile_angle``, :class:`WaveBands`): all channels (η, s_x, s_y)
         of a band in one call, 16 calls for the default layout. Bilinear interpolation at a
         fraction u of a texel keeps a share (1 − u)² + u² + 2u(1 − u) cos θ of a mode's variance per
         axis (θ = k_axis × texel), (2 + cos θ)/3 on average over positions;
@@ -360,7 +362,8 @@ class WaveField:
     def slope_tiles(self, time_s: torch.Tensor) -> torch.Tensor:
         """The slopes of every band on its own tile at times ``time_s`` ((B,) float64 [s], checked by the
         caller), (n_bands, B, 2, N, N): (s_x, s_y) world frame, dimensionless, at texel (row i, column j) =
-        (y, x) = (i, j) · L_o / N of band o's period L_o (``bands.tile_length``); what :meth:`sample` reads
+        tile coordinates (v, u) = (i, j) · L_o / N of band o's period L_o (``bands.tile_length``; the tile's
+        axes are turned by ``bands.tile_angle``, world points map to it by ``bands.tile_units``); what :meth:`sample` reads
         bilinearly at full band weight. For filtering a band's slopes on its periodic tile (the renderer's
         patch moments, :mod:`roughsea_torch.renderer.lean`)."""
         tiles = self._tiles(time_s, elevation=False)
@@ -516,11 +519,11 @@ class WaveField:
                 copy[..., :, 2 * n] = copy[..., :, 0]
                 doubled = {g: copy[j] for j, g in enumerate(group)}
             tile = doubled[o]
-            k_o, length = self.bands.band_wavenumber[o], self.bands.tile_length[o]
+            k_o = self.bands.band_wavenumber[o]
             for lo, hi in runs:
                 for a in range(lo, hi, chunk):
                     e = min(hi, a + chunk)
-                    grid = xy[:, a:e] * (1.0 / length)
+                    grid = self.bands.tile_units(o, xy[:, a:e])
                     grid = torch.frac(grid) if grid.requires_grad else torch.frac(grid, out=grid)
                     values = F_nn.grid_sample(tile, grid.unsqueeze(1), mode="bilinear", padding_mode="border",
                                               align_corners=True).squeeze(2)  # (B, C, P')

@@ -140,7 +140,8 @@ def test_texture_is_zero_mean_clutter_around_the_expectation(wind):
     plausible clutter (std between 0.01 and 3 K); over eight realizations the mean departure over
     the sea pixels is zero within 4 standard errors of the realizations' own means (the expectation
     is the ensemble mean; the brightness temperature's curvature leaves ~1e-4 K: 0.002 K allowed).
-    A bias of 0.4 of the clutter's std (plant ``+ 0.4 * std`` on ``tex``) fails. Without whitecaps
+    A bias of 0.6 of the clutter's std (plant ``+ 0.6 * std`` on ``tex``) fails (at 12 m/s the realizations'
+    means scatter by 0.12 of the clutter's std: waves longer than the image). Without whitecaps
     (their ensemble mean: tests/renderer/test_foam_terms.py)."""
     kw = dict(wind_speed=wind, pitch_deg=-15.0, altitude_m=10.0, roll_deg=0.0, hfov_deg=30.0, same_on_batch=True,
               foam=0.0)  # the waves' texture (whitecaps, rare and dark, make the realizations' means heavy-tailed)
@@ -158,7 +159,7 @@ def test_texture_is_zero_mean_clutter_around_the_expectation(wind):
     se = float(d.mean(1).std()) / math.sqrt(B)  # the realizations' means scatter (waves longer than the image)
     assert 0.01 < std < 3.0
     assert abs(mean) < 4 * se + 0.002, (mean, se, std)
-    assert 4 * se + 0.002 < 0.4 * std  # the check can see a bias of 0.4 of the clutter
+    assert 4 * se + 0.002 < 0.6 * std  # the check can see a bias of 0.6 of the clutter
     # the realizations differ from each other (not one texture repeated)
     assert float((tex[0] - tex[1])[:, sea].abs().max()) > 0.1 * std
 

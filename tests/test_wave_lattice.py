@@ -16,7 +16,9 @@ pytestmark = pytest.mark.usefixtures("one_thread")
 
 def _lattice_covariance(bands: WaveBands, wind: float, wind_direction: float, bilinear: bool = True) -> torch.Tensor:
     """Σ over each band's lattice modes of F(k, φ) Δk² k kᵀ (× the bilinear factor), rebuilt from the
-    public spectrum: modes k = Δk (i, j), inner_radius ≤ |(i, j)| < inner_radius · k⁺/k⁻."""
+    public spectrum: modes k = Δk (i û + j v̂), inner_radius ≤ |(i, j)| < inner_radius · k⁺/k⁻, along the
+    tile's axes û = (cos α, sin α), v̂ = (−sin α, cos α), α = o · tile_rotation (band o; the bilinear factor
+    counts along the tile's axes)."""
     out = []
     for o in range(bands.n_bands):
         dk, n = bands.fundamental[o], bands.tile_size
@@ -26,7 +28,9 @@ def _lattice_covariance(bands: WaveBands, wind: float, wind_direction: float, bi
         i, j = torch.meshgrid(idx, idx, indexing="xy")
         r2 = i**2 + j**2
         keep = (r2 >= bands.inner_radius**2) & (r2 < (bands.inner_radius * ratio) ** 2)
-        kx, ky = i[keep] * dk, j[keep] * dk
+        alpha = o * bands.tile_rotation
+        kx = (i[keep] * math.cos(alpha) - j[keep] * math.sin(alpha)) * dk
+        ky = (i[keep] * math.sin(alpha) + j[keep] * math.cos(alpha)) * dk
         phi = torch.atan2(ky, kx) - (wind_direction + math.pi)  # from downwind
         v = elfouhaily_spectrum(torch.sqrt(kx**2 + ky**2), phi, wind) * dk**2
         if bilinear:
@@ -35,7 +39,8 @@ def _lattice_covariance(bands: WaveBands, wind: float, wind_direction: float, bi
     return torch.stack(out)
 
 
-@pytest.mark.parametrize("bands", [WaveBands(), WaveBands(k_edges=(3.0, 5.0, 9.0), tile_size=64, inner_radius=5.0)])
+@pytest.mark.parametrize("bands", [WaveBands(), WaveBands(tile_rotation=0.0),
+                                   WaveBands(k_edges=(3.0, 5.0, 9.0), tile_size=64, inner_radius=5.0)])
 def test_band_covariance_is_the_lattice_sum(bands):
     """band_covariance = Σ over the band's discrete modes of F(k, φ) Δk² k kᵀ × (2 + cos θx)(2 + cos θy)/9
     (the position-averaged bilinear factor), in the world frame for wind_direction 0.7 rad."""

@@ -166,7 +166,7 @@ class ShortWaveMoments:
                 ra = pick(row)
                 t = jc.index_select(0, ra) - float(lv)
                 us = u.index_select(0, ra)
-                grid = torch.remainder(pick(xy) * (1.0 / self.length[o]), 1.0).mul_(2.0).sub_(1.0).to(dtype)[None, None]
+                grid = torch.remainder(self.field.bands.tile_units(o, pick(xy)), 1.0).mul_(2.0).sub_(1.0).to(dtype)[None, None]
                 pair = lev[lv:lv + 2].reshape(1, -1, *lev.shape[-2:])  # (1, 10 or 5, N + 1, N + 1)
                 read = F.grid_sample(pair, grid, mode="bilinear", padding_mode="border", align_corners=True)[0, :, 0]
                 lo = read[:5]

@@ -39,12 +39,26 @@ def test_patch_moments_are_the_gaussian_weighted_moments_of_the_slopes(level):
     bilinear reads); halfway between levels, where two are blended, to 8 % and 7 % (measured ≤ 6.2 % and
     ≤ 4.9 %). Planted, the filter's width p/√12 taken as p/2: 39 % and 28 % at level −1, 36 % and 16 % at 0;
     the nearest level instead of the blend: 22–26 % of the rms at ±0.5."""
-    field = _one_band_field()
+    _check_against_direct(_one_band_field(), 0, level, 1.0)
+
+
+@pytest.mark.parametrize("level", [-1, 0.5])
+def test_patch_moments_read_a_turned_tile_where_the_field_has_it(level):
+    """The same on the second band of a two-octave layout (4–8–16 rad/m), whose tile is turned by the golden
+    angle (137.5°) from the world axes, the first band resolved (footprint π/(√2 k₀): window 1 for band 0, 0 for
+    band 1): the moments must read the turned tile at the point's tile coordinates. Planted, the tile read at
+    (x, y)/L_o as if unturned: the means are off by about their rms."""
+    field = rs.WaveField(5.0, seed=3, dtype=F64, bands=WaveBands(k_edges=(4.0, 8.0, 16.0)))
+    _check_against_direct(field, 1, level, math.pi / (math.sqrt(2.0) * field.bands.band_wavenumber[0]) * (1 + 1e-9))
+
+
+def _check_against_direct(field, o: int, level: float, footprint: float) -> None:
+    """Band ``o`` of ``field`` wholly unresolved at ``footprint`` [m] and every band below it resolved."""
     t = torch.tensor([2.0], dtype=F64)
-    lam = 2.0 * math.pi / BAND.band_wavenumber[0]
+    lam = 2.0 * math.pi / field.bands.band_wavenumber[o]
     p = (2.0 ** level) * lam
     pts = torch.tensor([[0.3, 0.7], [5.1, -2.2], [11.0, 3.3]], dtype=F64)
-    mx, my, cxx, cyy, cxy, *_ = ShortWaveMoments(field, 0, t)(pts[:, 0], pts[:, 1], torch.full((3,), 1.0, dtype=F64),
+    mx, my, cxx, cyy, cxy, *_ = ShortWaveMoments(field, 0, t)(pts[:, 0], pts[:, 1], torch.full((3,), footprint, dtype=F64),
                                                               torch.full((3,), p, dtype=F64))
     sig = p / math.sqrt(12.0)
     h = lam / 48.0
@@ -53,11 +67,13 @@ def test_patch_moments_are_the_gaussian_weighted_moments_of_the_slopes(level):
     ox, oy = torch.meshgrid(off, off, indexing="xy")
     w = torch.exp(-(ox * ox + oy * oy) / (2.0 * sig * sig)).reshape(-1)
     w = w / w.sum()
-    var = field.band_covariance()[0, 0]
+    var = field.band_covariance()[0, o]
     rms = float((var[0] + var[1]).sqrt())
     for i in range(3):
-        s = field.sample((pts[i, 0] + ox).reshape(1, -1), (pts[i, 1] + oy).reshape(1, -1), time_s=2.0)
-        sx, sy = s["slope_x"][0], s["slope_y"][0]
+        x, y = (pts[i, 0] + ox).reshape(1, -1), (pts[i, 1] + oy).reshape(1, -1)
+        s = field.sample(x, y, time_s=2.0)
+        r = field.sample(x, y, time_s=2.0, footprint=torch.full_like(x, footprint))
+        sx, sy = s["slope_x"][0] - r["slope_x"][0], s["slope_y"][0] - r["slope_y"][0]
         ex, ey = (w * sx).sum(), (w * sy).sum()
         direct = (ex, ey, (w * sx * sx).sum() - ex * ex, (w * sy * sy).sum() - ey * ey, (w * sx * sy).sum() - ex * ey)
         got = (mx[i], my[i], cxx[i], cyy[i], cxy[i])
