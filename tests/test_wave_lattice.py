@@ -1,5 +1,6 @@
 """The Fourier lattice of each band (roughsea_torch.wave_lattice): the band covariances a field
-reports are the sums over its discrete modes, with the bilinear interpolation's loss. Single-threaded,
+reports are the sums over its discrete modes, with the bilinear interpolation's loss; a turned band's waves
+travel downwind in the world frame. Single-threaded,
 as tests/test_waves.py."""
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ import math
 import pytest
 import torch
 
+from roughsea_torch.spectrum import dispersion
 from roughsea_torch.waves import WaveBands, WaveField, elfouhaily_spectrum
 
 pytestmark = pytest.mark.usefixtures("one_thread")
@@ -71,3 +73,37 @@ def test_bilinear_correction_on_a_coarse_tile():
         assert 4 * se < 0.03 and abs(mean) < 0.03, (key, mean, se)
     uncorrected = _lattice_covariance(bands, 10.0, 0.3, bilinear=False)[0]
     assert float(uncorrected[0] / cov[0, 0]) > 1.10
+
+
+def test_a_turned_band_travels_downwind_along_its_own_axis():
+    """Band 1 of the layout (0.125–0.5–0.505 rad/m, inner radius 4) is turned by the golden angle α = 137.5°
+    and holds only the lattice modes (±4, 0), (0, ±4) along its tile's axes: k = 4Δk û, û = (cos α, sin α),
+    and 4Δk v̂. The slope along û, s_û = s_x cos α + s_y sin α, sees only the (±4, 0) pair (k ∥ û: a plane
+    wave along û). With the wind 0.3 rad off û (upwind axis at α + π + 0.3) that wave travels downwind,
+    along +û at its phase speed c = ω(k)/k: s_û(x + c t û, t) = s_û(x, 0) on the band's texel nodes (no
+    interpolation), and not upwind. Band 1 alone: the field at every band minus the field at a footprint
+    that keeps band 0 whole and band 1 out. (Planted, the travel signs taken from the tile's indices, not
+    the world wavevector: the wave runs along −û and the test fails.)"""
+    k1 = 0.5
+    bands = WaveBands(k_edges=(k1 / 4, k1, 1.01 * k1))
+    alpha = bands.tile_angle[1]
+    assert abs(math.degrees(alpha) - 137.5) < 0.1  # the default turn (band 1: once the golden angle)
+    field = WaveField(10.0, 7, wind_direction=alpha + math.pi + 0.3, dtype=torch.float64, bands=bands)
+    c = float(dispersion(torch.tensor(k1, dtype=torch.float64))) / k1
+    h = bands.tile_length[1] / bands.tile_size
+    shift, t = 5 * h, 5 * h / c
+    ux, uy, vx, vy = math.cos(alpha), math.sin(alpha), -math.sin(alpha), math.cos(alpha)
+    u = torch.arange(128, dtype=torch.float64)[None] * h  # texel nodes: u = m h, v = 3 h
+    keep0 = torch.full_like(u, math.pi / (math.sqrt(2.0) * bands.band_wavenumber[0]) * (1 + 1e-9))
+
+    def s_u(along: float, time: float) -> torch.Tensor:
+        x, y = (u + along) * ux + 3 * h * vx, (u + along) * uy + 3 * h * vy
+        full, low = field.sample(x, y, time, elevation=False), field.sample(x, y, time, footprint=keep0, elevation=False)
+        return (full["slope_x"] - low["slope_x"]) * ux + (full["slope_y"] - low["slope_y"]) * uy
+
+    s0 = s_u(0.0, 0.0)
+    scale = float(s0.abs().max())
+    assert scale > 0
+    torch.testing.assert_close(s_u(shift, t), s0, rtol=0, atol=1e-9 * scale)
+    assert float((s_u(0.0, t) - s0).abs().max()) > 0.5 * scale  # it did move
+    assert float((s_u(-shift, t) - s0).abs().max()) > 0.5 * scale  # not upwind
