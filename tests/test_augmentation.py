@@ -137,19 +137,23 @@ def test_texture_replays_bit_for_bit_and_differs_between_draws():
 @pytest.mark.parametrize("wind", [5.0, 12.0])
 def test_texture_is_zero_mean_clutter_around_the_expectation(wind):
     """At near range (10 m up, 15° down) the texture departs from the expectation image by a
-    plausible clutter (std between 0.01 and 3 K); over eight realizations the mean departure over
+    plausible clutter (std between 0.01 and 3 K); over sixteen realizations the mean departure over
     the sea pixels is zero within 4 standard errors of the realizations' own means (the expectation
     is the ensemble mean; the brightness temperature's curvature leaves ~1e-4 K: 0.002 K allowed).
-    A bias of 0.6 of the clutter's std (plant ``+ 0.6 * std`` on ``tex``) fails (at 12 m/s the realizations'
-    means scatter by 0.12 of the clutter's std: waves longer than the image). Without whitecaps
+    A bias of 0.4 of the clutter's std (plant ``+ 0.4 * std`` on ``tex``) fails. (At 12 m/s the
+    realizations' means scatter by 0.22-0.35 of the clutter's std, waves longer than the image: with
+    eight realizations 4 standard errors + 0.002 K reached 0.51 of the std on the tiles turned per band,
+    0.34 with these sixteen; 0.14-0.17 at 5 m/s.) Without whitecaps
     (their ensemble mean: tests/renderer/test_foam_terms.py)."""
     kw = dict(wind_speed=wind, pitch_deg=-15.0, altitude_m=10.0, roll_deg=0.0, hfov_deg=30.0, same_on_batch=True,
               foam=0.0)  # the waves' texture (whitecaps, rare and dark, make the realizations' means heavy-tailed)
     aug = small(**kw)
     aug(torch.zeros(1, 1, H, W), generator=torch.Generator().manual_seed(0))
-    B = 8
+    seeds = [11, 2**40 + 3, 77777, 2**61 + 5, 5, 2**33 + 1, 424242, 2**50 + 9,
+             12, 2**41 + 7, 31337, 2**62 + 11, 6, 2**34 + 3, 909090, 2**51 + 13]
+    B = len(seeds)
     params = {k: v.expand(B).clone() for k, v in aug._params.items() if v.ndim == 1 and v.shape[0] == 1}
-    params["wave_seed"] = torch.tensor([11, 2**40 + 3, 77777, 2**61 + 5, 5, 2**33 + 1, 424242, 2**50 + 9])
+    params["wave_seed"] = torch.tensor(seeds)
     tex = aug(torch.zeros(B, 1, H, W), params=params)
     flat = small(texture=False, **kw)(torch.zeros(B, 1, H, W), params={k: v for k, v in params.items()
                                                                        if k not in ("wave_seed", "time_s")})
@@ -159,7 +163,7 @@ def test_texture_is_zero_mean_clutter_around_the_expectation(wind):
     se = float(d.mean(1).std()) / math.sqrt(B)  # the realizations' means scatter (waves longer than the image)
     assert 0.01 < std < 3.0
     assert abs(mean) < 4 * se + 0.002, (mean, se, std)
-    assert 4 * se + 0.002 < 0.6 * std  # the check can see a bias of 0.6 of the clutter
+    assert 4 * se + 0.002 < 0.4 * std  # the check can see a bias of 0.4 of the clutter
     # the realizations differ from each other (not one texture repeated)
     assert float((tex[0] - tex[1])[:, sea].abs().max()) > 0.1 * std
 
