@@ -311,7 +311,8 @@ def crest_ensemble() -> dict[str, torch.Tensor]:
     with torch_threads(1):
         field = rs.WaveField(torch.full((n,), ENSEMBLE_WIND), list(range(n)), wind_direction=0.4, dtype=torch.float32)
         gen = torch.Generator().manual_seed(0)
-        side = field.bands.tile_length[0]  # every tile length divides it: uniform on every tile
+        side = field.bands.tile_length[0]  # band 0's period, the area of 4^o cells of band o's turned tile:
+        # uniform on every tile but at the square's edges (cross terms of zero mean over seeds)
         x = (torch.rand(n, npts, generator=gen, dtype=torch.float64) * side).float()
         y = (torch.rand(n, npts, generator=gen, dtype=torch.float64) * side).float()
         k = len(ENSEMBLE_FOOTPRINTS)

@@ -42,7 +42,8 @@ def test_sampled_covariance_matches_band_covariance():
     est, ref = [], []  # per seed: (footprint, moment) pairs
     for start in range(0, n_seeds, group):
         field = WaveField(torch.full((group,), 10.0), list(range(start, start + group)), wind_direction=0.7, dtype=dtype)
-        side = field.bands.tile_length[0]  # every tile length divides it: uniform on every tile
+        side = field.bands.tile_length[0]  # band 0's period, the area of 4^o cells of band o's turned tile:
+        # uniform on every tile but at the square's edges (cross terms of zero mean over seeds)
         x = (torch.rand(group, npts, generator=gen, dtype=torch.float64) * side).to(dtype)
         y = (torch.rand(group, npts, generator=gen, dtype=torch.float64) * side).to(dtype)
         fp = torch.tensor(footprints, dtype=dtype).repeat_interleave(npts).expand(group, -1)
