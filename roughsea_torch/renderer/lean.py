@@ -95,7 +95,7 @@ class ShortWaveMoments:
         """Band ``o``'s filtered tiles, (len(LEVELS), 5, N + 1, N + 1): (⟨s_x⟩, ⟨s_y⟩, ⟨s_x²⟩, ⟨s_y²⟩,
         ⟨s_x s_y⟩) at each level, circularly padded by one texel (texel N = texel 0)."""
         if o not in self._levels:
-            s = self._band_slopes()[o]  # (2, N, N), rows y, columns x
+            s = self._band_slopes()[o]  # (2, N, N) world (s_x, s_y); rows v, columns u: turned axes
             n = s.shape[-1]
             fields = torch.stack([s[0], s[1], s[0] * s[0], s[1] * s[1], s[0] * s[1]])
             spec = torch.fft.rfft2(fields)
