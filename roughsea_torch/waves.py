@@ -342,7 +342,10 @@ class WaveField:
             )
         w2 = self.band_weights(f) ** 2  # (B, ..., n_bands)
         flat = w2.reshape(self.batch_size, -1, self.n_bands)
-        return torch.bmm(flat, per_band).reshape(*f.shape, per_band.shape[-1])
+        # image by image: a batched matmul's rounding depends on the batch size, and image i must be
+        # bitwise the image alone
+        out = torch.stack([torch.mm(flat[b], per_band[b]) for b in range(self.batch_size)])
+        return out.reshape(*f.shape, per_band.shape[-1])
 
     def _windowed_variance(self, band_var: torch.Tensor, footprint: Any) -> torch.Tensor:
         if footprint is None:

@@ -353,6 +353,16 @@ def _check_batch_equals_alone(dtype: torch.dtype, npts: int, times: tuple[float,
                 assert torch.equal(together[key][i : i + 1], single[key]), (key, i, t)
     for i in range(3):
         assert torch.equal(batch.band_covariance()[i], alone[i].band_covariance()[0])
+    # the footprint-windowed statistics too (the renderer's node values use them; a batched matmul rounded
+    # them by the batch size, and a textured image then depended on how its batch was grouped)
+    for name in ("elevation_variance", "crest_variance"):
+        together = getattr(batch, name)(fp)
+        for i in range(3):
+            assert torch.equal(together[i : i + 1], getattr(alone[i], name)(fp[i : i + 1])), (name, i)
+    together = batch.resolved_covariance(fp)
+    for i in range(3):
+        single = alone[i].resolved_covariance(fp[i : i + 1])
+        assert all(torch.equal(a[i : i + 1], b) for a, b in zip(together, single)), i
 
 
 def test_batch_member_equals_image_alone_bitwise(dtype, monkeypatch):
