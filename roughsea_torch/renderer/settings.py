@@ -120,6 +120,14 @@ class TableSize:
             the first hit's time. Near grazing at light wind a pixel holds few patches of the waves
             shorter than the samples' footprint, and their realization carries clutter an expectation
             over them does not (``docs/subpixel_clutter.md``).
+        texture_hit_foam_tilt: with ``texture_hit="first"`` and whitecaps on the crests, each visible sample's
+            foam seen at its own resolved facet's incidence (default True), not at the mean plane's view
+            zenith θ̂: near grazing the crests that carry the foam lean towards the camera, and foam's
+            emissivity and reflected sky change steeply with incidence (LWIR, 15 m/s: a foam patch 6.6 K
+            darker than the water at 88°, 0.9 K at 80°; ``docs/foam_table.md``). Added per sample as
+            f (R_foam(θ_f) − R_foam(θ̂)) for each state, θ_f from cos θ_f = (cos θ̂ + sin θ̂ a)/√(1 + |s|²) (s the
+            reconciled resolved slope, a its component towards the sensor), through the path's τ.
+            False: the foam in the mean plane, as with ``"flat"``.
         texture_antialias: True (default): the flat-point texture and crest-foam fraction are
             low-pass filtered along the image's columns, with a zero at the rows' Nyquist frequency
             (:mod:`~roughsea_torch.renderer.antialias`: the resolved band there would fold into
@@ -181,6 +189,7 @@ class TableSize:
     texture_hit_cross: bool = True
     texture_hit_lean: bool = False
     texture_hit_lean_across: float = 0.7
+    texture_hit_foam_tilt: bool = True
     texture_azimuth_sun: int = 9
     zenith_narrow: int = 21
     azimuth_day: int = 25
@@ -220,7 +229,7 @@ class TableSize:
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real) or not lo <= float(v) <= hi:
                 raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")
             object.__setattr__(self, name, float(v))
-        for name in ("texture_hit_cross", "texture_hit_lean"):
+        for name in ("texture_hit_cross", "texture_hit_lean", "texture_hit_foam_tilt"):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise ValueError(f"TableSize.{name} must be a bool; got {getattr(self, name)!r}")
         if self.texture_hit_lean and self.texture_hit != "first":

@@ -21,11 +21,15 @@ from .._parallel import BLOCK, in_blocks
 from ..clutter import along_variance, footprint, reconcile_scale, resolved_quantile, view_moments
 from ..geometry import slant_range
 from ..whitecaps import whitecap_cover
+from .foam_terms import foam_state_radiances_of_images
 from .hits import (Sweep, covers, flat_nonzero, footprint_fade, nonzero_2d, pixel_hits, pixel_windows, read_at,
                    sweep_envelope, sweep_layout, track_windows, visible_samples)
 from .lean import ELL_CLAMP, ShortWaveMoments, projected_area, weighted_window
+from .path import path_rows
 
-__all__ = ["SweptTexture"]
+__all__ = ["SweptTexture", "facet_cosine"]
+
+FOAM_NODES = 1025  # nodes in cos θ of the foam's radiance per image (TableSize.texture_hit_foam_tilt)
 
 
 class SweptTexture:
@@ -45,7 +49,9 @@ class SweptTexture:
         g · the sweep's + (1 − g) · the flat point's), so where the pixel resolves no band it is the flat
         point's, i.e. the expectation image."""
         zero = torch.zeros_like(dz)
-        texture, x_c, f_pix = zero.clone(), zero.clone(), (zero.clone(), zero.clone()) if crest else None
+        # with crest: the covers (f_act, f_res) and, with the foam's tilt, its radiance change from the mean plane's
+        n_foam = 2 + int(self.foam_tilt)
+        texture, x_c, f_pix = zero.clone(), zero.clone(), tuple(zero.clone() for _ in range(n_foam)) if crest else None
         cov_c = [zero.clone() for _ in range(3)]
         h = self.altitude[sl].to(self.dtype)
         for i in range(dz.shape[0]):
@@ -81,9 +87,11 @@ class SweptTexture:
             # (with the patch moments: the weighted average over the window's covered part, times that part)
             tex = weighted_window(avg[0], avg[-2], avg[-1]) if self.lean else avg[0]
             texture[i] = texture[i].index_put((s,), g * tex)
-            if crest:  # the active and residual covers
+            if crest:  # the active and residual covers (and the foam's tilt: the sweep's alone, 0 at the flat point)
                 for c in range(2):
                     f_pix[c][i] = f_pix[c][i].index_put((s,), flat[c] + g * avg[1 + c])
+                if self.foam_tilt:
+                    f_pix[2][i] = f_pix[2][i].index_put((s,), g * avg[3])
             # (x = 0 where g = 0: the pixel resolves nothing, its resolved covariance g² C is 0 too)
             x_c[i] = x_c[i].index_put((s,), torch.where(hit & (g.detach() > 0), read_at(*x_k, k * sw.shape[1] + j),
                                                          torch.zeros_like(tan_g)))
@@ -201,12 +209,50 @@ class SweptTexture:
             f_act, f_res = whitecap_cover(wf, Xv, Yv, t_s, fv, smp["crest"], var_r, wf.crest_variance()[:, None],
                                           self.p.foam[im:im + 1].to(dtype)[:, None], trails=self.foam_trails)
             values += [f_act[0], f_res[0]]
+            if self.foam_tilt:
+                values.append(self._foam_tilt(im, row, col, cx, sx, cos_k, cov_k, smp["slope_x"][0], smp["slope_y"][0],
+                                              f_act[0], f_res[0]))
         values += weights
         # back to every sample (0 at the hidden ones), in the (nt, ns) layout of the envelope, row by row
         full, at = x_v.new_zeros(len(values), nt * ns), (col * ns).add_(row)
         for c, v in enumerate(values):
             full[c].index_copy_(0, at, v)
         return full.reshape(-1, nt, ns), (sel, x_v), cov_k
+
+    def _foam_tilt(self, im: int, row: torch.Tensor, col: torch.Tensor, cx: torch.Tensor, sx: torch.Tensor,
+                   cos_k: torch.Tensor, cov_k: tuple, s_x: torch.Tensor, s_y: torch.Tensor, f_act: torch.Tensor,
+                   f_res: torch.Tensor) -> torch.Tensor:
+        """τ [f_act (R_act(θ_f) − R_act(θ̂)) + f_res (R_res(θ_f) − R_res(θ̂))] at the read samples of image ``im``
+        (sweep rows ``row``, tracks ``col``; the tracks' ray directions ``cx``, ``sx`` and the rows' cos θ̂
+        ``cos_k``; the resolved slopes ``s_x``, ``s_y`` and the covers there): the foam's radiance change when it
+        lies on the sample's resolved facet, seen at θ_f (:func:`facet_cosine` of the reconciled slope λ s,
+        ``docs/texture.md`` §7), rather than in the mean plane (``TableSize.texture_hit_foam_tilt``); τ the
+        path's transmittance at the row (1 without a path)."""
+        p, dtype = self.p, self.dtype
+        out = torch.zeros_like(f_act)
+        on = flat_nonzero((f_act + f_res).detach() > 0)  # (the samples without foam add nothing)
+        if on.numel() == 0:
+            return out
+        pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731
+        row, col = row.index_select(0, on), col.index_select(0, on)
+        lam = pick(reconcile_scale(cov_k, p.vx[im], p.vy[im], p.cxy[im], p.wind_direction[im]), row)
+        ct = pick(cos_k, row)
+        cos_f = facet_cosine(ct, pick(cx, col), pick(sx, col), lam * s_x.index_select(0, on), lam * s_y.index_select(0, on))
+        # both states' radiances on FOAM_NODES nodes uniform in cos θ (interior: acos' is infinite at 1), linear
+        # between them (the foam's emissivity is smooth in θ but for kinks, sub-node here)
+        nodes = torch.linspace(0.0, 1.0, FOAM_NODES, dtype=torch.float64, device=ct.device).clamp(1e-6, 1.0 - 1e-6)
+        act, res = foam_state_radiances_of_images(torch.acos(nodes).to(dtype)[None], p, slice(im, im + 1), self.scene)
+        u = torch.stack([cos_f, ct]).clamp(0.0, 1.0) * (FOAM_NODES - 1)
+        i0 = torch.floor(u.detach()).clamp(max=FOAM_NODES - 2).long()
+        w = u - i0
+        lerp = lambda t: t[0].index_select(0, i0.reshape(-1)).reshape(i0.shape) * (1 - w) + \
+            t[0].index_select(0, (i0 + 1).reshape(-1)).reshape(i0.shape) * w  # noqa: E731
+        ra, rr = lerp(act), lerp(res)  # (2, P'): at the facet's incidence, at the mean plane's
+        d = f_act.index_select(0, on) * (ra[0] - ra[1]) + f_res.index_select(0, on) * (rr[0] - rr[1])
+        if self.scene.path is not None:
+            tau, _ = path_rows(self.scene.path, cos_k[None], self.altitude[im:im + 1].to(dtype)[:, None], self.earth_radius_m)
+            d = d * pick(tau[0].to(dtype), row)
+        return out.index_put((on,), d)
 
     def _lean_samples(self, im: int, wf: Any, sw: Sweep, fpk: torch.Tensor, cov_k: tuple, x: torch.Tensor,
                       y: torch.Tensor, row: torch.Tensor, col: torch.Tensor, s_x: torch.Tensor, s_y: torch.Tensor,
@@ -270,3 +316,15 @@ def _across_quantile(slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple, d
     c_r = slope_y * ex - slope_x * ey - cov_ap * x * inv_a.sqrt()
     y = c_r * torch.rsqrt(torch.where(ok, var_r, torch.ones_like(var_r)))
     return torch.where(ok, y.clamp(-3.5, 3.5), torch.zeros_like(y))
+
+
+def facet_cosine(cos_view: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, slope_x: torch.Tensor,
+                 slope_y: torch.Tensor) -> torch.Tensor:
+    """cos of the angle between a facet's normal and the line of sight to the sensor: (cos θ̂ + sin θ̂ a)/√(1 + |s|²),
+    for a view of zenith cosine ``cos_view`` whose ray runs along the horizontal unit vector (``dx``, ``dy``)
+    (camera → sea), and a facet of world-frame slope s = (``slope_x``, ``slope_y``) = −∇η (``docs/physics.md``
+    §2; normal (s, 1)/√(1 + |s|²)); a = −s · (dx, dy) is its slope towards the sensor. Negative where the facet
+    faces away. All broadcast together."""
+    sin_view = torch.sqrt((1.0 - cos_view * cos_view).clamp_min(0.0))
+    a = -(slope_x * dx + slope_y * dy)
+    return (cos_view + sin_view * a) * torch.rsqrt(1.0 + slope_x * slope_x + slope_y * slope_y)

@@ -545,8 +545,10 @@ def per_pixel_terms(plan: RenderPlan, ft: FineTable, maps: TableMaps, rays: Pixe
         # no foam in the sky: there the covers would be a W and (1 − a) W, and the mix would take that
         # share of the sky pixels from the foam channels' sky rows, which lack the day's scattered sky
         # (added to the sky pixels of channel 0 above)
-        f_act, f_res = (torch.where(sea, f, torch.zeros_like(f)) for f in f_pix)
+        f_act, f_res = (torch.where(sea, f, torch.zeros_like(f)) for f in f_pix[:2])
         vals = vals + f_act * (foam_vals[:, 0] - vals) + f_res * (foam_vals[:, 1] - vals)
+        if len(f_pix) > 2:  # the first hit's foam on its facets, at their own incidence (TableSize.texture_hit_foam_tilt)
+            vals = vals + torch.where(sea, f_pix[2], torch.zeros_like(f_pix[2]))
     if plan.sunny and ft.has_sky:  # the sun's disk itself, where it is in view
         ifov = (1.0 / plan.cameras.cameras.fx.to(dtype))[sl]
         vals = vals + sun_disk_pixels(scene, plan.B, sl, cos, dx, dy, ~sea, ifov)

@@ -108,6 +108,9 @@ class TextureTable(SweptTexture):
         self.radiance_channels = ([True] + ([False] if scene.sun is not None else []) + [True, True] * self.cross
                                   + [True, True] * self.lean)
         self.foam_trails = bool(table.foam_trails)
+        # each visible sample's foam at its resolved facet's incidence (TableSize.texture_hit_foam_tilt): one
+        # more channel per sample, the foam's radiance change from the mean plane's
+        self.foam_tilt = self.first_hit and bool(table.texture_hit_foam_tilt)
         self.antialias = bool(table.texture_antialias)  # (renderer.antialias; the sweep is not filtered)
         # the sweep (TableSize.texture_hit_*): samples s(θ̂) pixels apart in depression, each filtered at
         # twice its spacing's footprint along the view, and the volume built for those footprints

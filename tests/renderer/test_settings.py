@@ -30,11 +30,13 @@ def test_texture_rules_accept_lists_and_numpy_numbers():
                                  dict(texture_hit_visibility=1.5), dict(texture_hit_visibility=float("nan")),
                                  dict(texture_hit_lean=1), dict(texture_hit_lean="yes"), dict(texture_hit_lean=True),
                                  dict(texture_hit_lean_across=0.0),
-                                 dict(texture_hit_lean_across=5.0)])
+                                 dict(texture_hit_lean_across=5.0), dict(texture_hit_foam_tilt=1),
+                                 dict(texture_hit_foam_tilt="no")])
 def test_first_hit_settings_out_of_range_name_themselves(bad):
     """The first hit's settings: where a pixel meets the waves ('first' or 'flat'), its texture nodes (≥ 2),
     its visibility factor (in [0.125, 1]), the patch moments' switch (a bool, and only with texture_hit='first':
-    with the flat point it would be ignored) and their patch width (in [0.05, 4] R δ): anything else is a
+    with the flat point it would be ignored), their patch width (in [0.05, 4] R δ) and the foam's tilt switch
+    (a bool): anything else is a
     ValueError naming the field."""
     with pytest.raises(ValueError, match=f"TableSize.{next(iter(bad))}"):
         rs.TableSize(**bad)
