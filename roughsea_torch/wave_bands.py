@@ -135,8 +135,19 @@ class WaveBands:
         if alpha == 0.0:
             return xy * (1.0 / length)
         c, s = math.cos(alpha) / length, math.sin(alpha) / length
-        m = torch.tensor([[c, -s], [s, c]], dtype=xy.dtype, device=xy.device)
-        return torch.matmul(xy, m)
+        # one multiplication or addition per kernel, each rounded once whatever the kernel's path (vector lanes
+        # or scalar tail), so a point's value does not depend on how it was batched; a 2×2 matmul costs about
+        # twice as much, a complex product's scalar tail rounds differently from its lanes
+        x, y = xy[..., 0], xy[..., 1]
+        if xy.requires_grad:
+            return torch.stack((x * c + y * s, y * c - x * s), -1)
+        out = torch.empty_like(xy)
+        u, v = out[..., 0], out[..., 1]
+        torch.mul(x, c, out=u)
+        u.add_(y * s)
+        torch.mul(y, c, out=v)
+        v.sub_(x * s)
+        return out
 
     @property
     def max_index(self) -> int:

@@ -528,8 +528,7 @@ class WaveField:
                     e = min(hi, a + chunk)
                     grid = self.bands.tile_units(o, xy[:, a:e])
                     grid = torch.frac(grid) if grid.requires_grad else torch.frac(grid, out=grid)
-                    values = F_nn.grid_sample(tile, grid.unsqueeze(1), mode="bilinear", padding_mode="border",
-                                              align_corners=True).squeeze(2)  # (B, C, P')
+                    values = _bilinear(tile, grid)  # (B, C, P')
                     flagged = None if part is None else np.flatnonzero(part[a // _BLOCK : -(-e // _BLOCK)])
                     if flagged is not None and flagged.size:  # the window where it may be below 1 (exactly 1
                         # elsewhere), one span from the first to the last flagged block of the chunk
@@ -544,6 +543,26 @@ class WaveField:
                                 values[..., u - a : v - a] *= w
                     acc[..., a:e] += values  # in place on our own buffer; autograd records the slice
         return acc
+
+
+def _bilinear(tile: torch.Tensor, grid: torch.Tensor) -> torch.Tensor:
+    """``grid_sample`` (bilinear, border, align_corners) of tiles (B, C, H, W) at points grid (B, P, 2) in [−1, 1]
+    → (B, C, P). grid_sample's CPU kernel runs its images in parallel, not its points: with fewer images than
+    threads the points are split into that many groups, each read as an image of its own (the tile expanded,
+    not copied), which changes no value."""
+    batch, npts = grid.shape[0], grid.shape[1]
+    k = torch.get_num_threads() // batch if grid.device.type == "cpu" else 1
+    if k < 2 or npts < 2048 * k:
+        return F_nn.grid_sample(tile, grid.unsqueeze(1), mode="bilinear", padding_mode="border",
+                                align_corners=True).squeeze(2)
+    per = -(-npts // k)
+    pad = per * k - npts
+    g = grid if pad == 0 else torch.cat([grid, grid[:, -1:].expand(batch, pad, 2)], 1)
+    g = g.reshape(batch * k, 1, per, 2)
+    t = tile[:, None].expand(batch, k, *tile.shape[1:]).reshape(batch * k, *tile.shape[1:])
+    out = F_nn.grid_sample(t, g, mode="bilinear", padding_mode="border", align_corners=True)  # (B k, C, 1, per)
+    out = out.reshape(batch, k, tile.shape[1], per).permute(0, 2, 1, 3).reshape(batch, tile.shape[1], per * k)
+    return out[..., :npts]
 
 
 def _runs(blocks: np.ndarray, npts: int, gap: int = 4) -> list[tuple[int, int]]:
