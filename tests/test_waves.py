@@ -380,6 +380,30 @@ def test_batch_member_equals_image_alone_bitwise_two_threads(monkeypatch, two_th
     _check_batch_equals_alone(torch.float32, 40_000, (3.5,))
 
 
+def test_one_image_on_two_threads_equals_one_thread_bitwise(monkeypatch, two_threads):
+    """One image on two threads: its band reads are split into a group of points per thread (grid_sample runs
+    images, not points, in parallel), which must change no value: the sample, on chunks that leave a ragged
+    last group, is bitwise the one-thread sample (and the wind gradient's value too)."""
+    monkeypatch.setattr(waves, "_CHUNK_ELEMENTS", 5001)
+    gen = torch.Generator().manual_seed(3)
+    x = torch.rand(1, 12003, generator=gen, dtype=torch.float64) * 400 - 200
+    y = torch.rand(1, 12003, generator=gen, dtype=torch.float64) * 400 - 200
+    f = torch.rand(1, 12003, generator=gen, dtype=torch.float64) * 3
+
+    def run() -> tuple[dict, torch.Tensor]:
+        wind = torch.tensor([9.0], dtype=torch.float64, requires_grad=True)
+        out = WaveField(wind, [4], wind_direction=0.7, dtype=torch.float64).sample(x, y, 2.5, footprint=f, crest=True)
+        (g,) = torch.autograd.grad(out["slope_x"].sum(), wind)
+        return {k: v.detach() for k, v in out.items()}, g
+
+    two, g_two = run()
+    torch.set_num_threads(1)
+    one, g_one = run()
+    for key in one:
+        assert torch.equal(two[key], one[key]), key
+    assert torch.allclose(g_two, g_one, rtol=1e-12, atol=0.0)
+
+
 @pytest.mark.parametrize("extent, tol", [(1.0, 5e-5), (30.0, 1e-3)])
 def test_float32_agrees_with_float64(extent, tol):
     """Same realization in both dtypes (draws float64 on the CPU, spectrum and phases float64, then
