@@ -548,8 +548,8 @@ class WaveField:
 def _bilinear(tile: torch.Tensor, grid: torch.Tensor) -> torch.Tensor:
     """``grid_sample`` (bilinear, border, align_corners) of tiles (B, C, H, W) at points grid (B, P, 2) in [−1, 1]
     → (B, C, P). grid_sample's CPU kernel runs its images in parallel, not its points: with fewer images than
-    threads the points are split into that many groups, each read as an image of its own (the tile expanded,
-    not copied), which changes no value."""
+    threads the points are split into that many groups, each read as an image of its own, which changes no
+    value (the tile is expanded, not copied, for one image; a batch of several copies each tile once per group)."""
     batch, npts = grid.shape[0], grid.shape[1]
     k = torch.get_num_threads() // batch if grid.device.type == "cpu" else 1
     if k < 2 or npts < 2048 * k:
