@@ -229,30 +229,29 @@ class SweptTexture:
         ``docs/texture.md`` §7), rather than in the mean plane (``TableSize.texture_hit_foam_tilt``); τ the
         path's transmittance at the row (1 without a path)."""
         p, dtype = self.p, self.dtype
-        out = torch.zeros_like(f_act)
-        on = flat_nonzero((f_act + f_res).detach() > 0)  # (the samples without foam add nothing)
-        if on.numel() == 0:
-            return out
+        if not bool(((f_act + f_res).detach() > 0).any()):  # (no foam on any sample: nothing to add)
+            return torch.zeros_like(f_act)
         pick = lambda v, idx: v.reshape(-1).index_select(0, idx)  # noqa: E731
-        row, col = row.index_select(0, on), col.index_select(0, on)
         lam = pick(reconcile_scale(cov_k, p.vx[im], p.vy[im], p.cxy[im], p.wind_direction[im]), row)
-        ct = pick(cos_k, row)
-        cos_f = facet_cosine(ct, pick(cx, col), pick(sx, col), lam * s_x.index_select(0, on), lam * s_y.index_select(0, on))
+        cos_f = facet_cosine(pick(cos_k, row), pick(cx, col), pick(sx, col), lam * s_x, lam * s_y)
         # both states' radiances on FOAM_NODES nodes uniform in cos θ (interior: acos' is infinite at 1), linear
-        # between them (the foam's emissivity is smooth in θ but for kinks, sub-node here)
-        nodes = torch.linspace(0.0, 1.0, FOAM_NODES, dtype=torch.float64, device=ct.device).clamp(1e-6, 1.0 - 1e-6)
+        # between them (the foam's emissivity is smooth in θ but for kinks, sub-node here); the mean plane's per
+        # sweep row, the facet's per sample
+        nodes = torch.linspace(0.0, 1.0, FOAM_NODES, dtype=torch.float64, device=cos_k.device).clamp(1e-6, 1.0 - 1e-6)
         act, res = foam_state_radiances_of_images(torch.acos(nodes).to(dtype)[None], p, slice(im, im + 1), self.scene)
-        u = torch.stack([cos_f, ct]).clamp(0.0, 1.0) * (FOAM_NODES - 1)
-        i0 = torch.floor(u.detach()).clamp(max=FOAM_NODES - 2).long()
-        w = u - i0
-        lerp = lambda t: t[0].index_select(0, i0.reshape(-1)).reshape(i0.shape) * (1 - w) + \
-            t[0].index_select(0, (i0 + 1).reshape(-1)).reshape(i0.shape) * w  # noqa: E731
-        ra, rr = lerp(act), lerp(res)  # (2, P'): at the facet's incidence, at the mean plane's
-        d = f_act.index_select(0, on) * (ra[0] - ra[1]) + f_res.index_select(0, on) * (rr[0] - rr[1])
+
+        def lerp(c: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:  # (R_act, R_res) at the cosines c
+            u = c.clamp(0.0, 1.0) * (FOAM_NODES - 1)
+            i0 = torch.floor(u.detach()).clamp(max=FOAM_NODES - 2).long()
+            w = u - i0
+            return tuple(t[0].index_select(0, i0) * (1 - w) + t[0].index_select(0, i0 + 1) * w for t in (act, res))
+
+        (fa, fr), (pa, pr) = lerp(cos_f), lerp(cos_k)
+        d = f_act * (fa - pick(pa, row)) + f_res * (fr - pick(pr, row))
         if self.scene.path is not None:
             tau, _ = path_rows(self.scene.path, cos_k[None], self.altitude[im:im + 1].to(dtype)[:, None], self.earth_radius_m)
             d = d * pick(tau[0].to(dtype), row)
-        return out.index_put((on,), d)
+        return d
 
     def _lean_samples(self, im: int, wf: Any, sw: Sweep, fpk: torch.Tensor, cov_k: tuple, x: torch.Tensor,
                       y: torch.Tensor, row: torch.Tensor, col: torch.Tensor, s_x: torch.Tensor, s_y: torch.Tensor,
