@@ -65,7 +65,9 @@ class TableSize:
         texture_first: the same with ``texture_hit="first"``, where x is the resolved slope at the hit
             as it is: the model's response is strongly curved in it near grazing, and 9 nodes (0 and
             ±1.72 where the slopes are) lose 6–23 % of the clutter's contrast against the ray tracer
-            at 5 m/s, 81–88° (``docs/texture_first_geometry.md``); 17 nodes cost 1.0–1.25×.
+            at 5 m/s, 81–88° (``docs/texture_first_geometry.md``); 17 nodes cost 1.0–1.25×. Since the
+            sweep's finer samples (2026-11-27) more of them reach the edges of x, where 17 nodes
+            leave 1.1 % of the clutter's σ (rms) against 65: 25 (0.25 %), within the timing noise.
         texture_zenith, texture_zenith_sun: ζ nodes of the texture (of a sunny scene, whose volume
             also carries the visible quantile x' = a'/σ_a of each pixel's unresolved Gaussian).
         texture_azimuth_sun: azimuth nodes of the texture of a sunny scene (on the mean table's span).
@@ -167,7 +169,7 @@ class TableSize:
     zenith_thin: int = 41
     fine_azimuth_thin: int = 128
     texture: int = 9
-    texture_first: int = 17
+    texture_first: int = 25
     texture_zenith: int = 33
     texture_zenith_sun: int = 65
     texture_width: float = 4.5

@@ -395,7 +395,10 @@ class TextureTable(SweptTexture):
         n_x, n_az = self.Lx.shape[0], self.La.shape[0]
         a_, b2 = a.to(dtype)[:, None, None], b.to(dtype)[:, None, None]
         col = ((2.0 * (o - a_) / (b2 - a_) - 1.0) / (1.0 + self.ea)).clamp(-1.0, 1.0).add(1.0).mul((n_az - 1) / 2.0)
-        z = (x / (self.width * (1.0 + self.ex))).clamp(-1.0, 1.0).add(1.0).mul((n_x - 1) / 2.0)
+        # (x within the nodes' range ±width: the fine grid's overhang beyond it, there for the other axes'
+        # reads, would extrapolate the nodes' polynomial, by up to ~1e6 for 65 nodes)
+        lim = 1.0 / (1.0 + self.ex)
+        z = (x / (self.width * (1.0 + self.ex))).clamp(-lim, lim).add(1.0).mul((n_x - 1) / 2.0)
         i0 = torch.floor(z.detach()).clamp_(max=n_x - 2)
         fz = z - i0
         scale = 2.0 / (n_x * n_az - 1)

@@ -461,10 +461,13 @@ def test_visibility_on_the_finer_elevation_matches_the_ray_tracer(grazing_ray_tr
 def test_first_hit_texture_nodes_resolve_the_model_response():
     """The first hit reads the model's response at the resolved slope as it is, through a Chebyshev–Lobatto
     volume in x = a/σ_a; near grazing that response is strongly curved. The default (TableSize.texture_first
-    = 17) equals a converged 65-node volume to an rms of 1 % of the clutter's standard deviation and 0.02 K
-    at most (5 m/s upwind, 15 m mast, 6° down, 48×64 over 12°, float64; measured 0.19 % and 3.8 mK). With 9
-    nodes (the flat point's count, the first hit's before) the error is 15 % rms and 0.20 K, with a +0.02 K
-    bias, and the test fails."""
+    = 25) equals a converged 65-node volume to an rms of 1 % of the clutter's standard deviation and 0.02 K
+    at most (5 m/s upwind, 15 m mast, 6° down, 48×64 over 12°, float64; measured 0.25 % and 4.7 mK; 17
+    nodes, the default before the sweep's finer samples of 2026-11-27, 1.1 % and 11 mK). With 9 nodes
+    the error is 72 % rms and 0.40 K, with a +0.16 K bias, and the test fails. Planted, the volume read
+    in x over the fine grid's overhang beyond the nodes (±width (1 + ex), as before 2026-11-27): the
+    65-node polynomial extrapolated there reaches 8900 (radiance units) against 3 at the nodes, a
+    sample of the sweep reads it, rms 0.60 K, and the test fails."""
     cams = rs.make_camera(48, 64, hfov_deg=12.0, altitude_m=15.0, pitch_deg=-6.0, dtype=torch.float64)
     kw = dict(wind_speed=5.0, sea_temperature=290.0, foam=False, path=False)
     sea = rs.view_geometry(cams).is_sea[0]
