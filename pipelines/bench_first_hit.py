@@ -9,8 +9,9 @@ far-field-heavy camera (20 m mast, pitch −2°: rows from 170 m to the horizon)
 timed in turn within one loop (so the machine's load falls on all of them), median of ``--repeats``,
 with 1 and 2 torch threads. ``--baseline DIR``: a checkout (e.g. ``git archive main roughsea_torch | tar -x
 -C DIR``) whose ``roughsea_torch`` is loaded beside this one under another name and timed as
-"first-hit, baseline". Variants: ``TableSize`` fields of approximate sweeps and the sweep with the unresolved
-waves' patch moments (``texture_hit_lean``), alone and on sweeps with ``texture_hit_across`` 1, 2 and 3, timed as well.
+"first-hit, baseline". Variants: ``TableSize`` fields of the sweep's parts (its two tracks per pixel, its
+cap on the samples' footprint, both as before 2026-11-27's evening), a coarser sweep (``texture_hit_across``
+2) and the unresolved waves' patch moments (``texture_hit_lean``), timed as well.
 
 Then, 1 thread, where the first-hit render's time goes (each stage timed around its call, the rest of
 the render left to "other"), and the sweep's size: samples per track, tracks, samples per pixel, the
@@ -50,13 +51,13 @@ SCENE = dict(wind_speed=10.0, sea_temperature=290.0, seed=11, time_s=3.0)
 CAMERA = dict(hfov_deg=12.0, altitude_m=15.0, pitch_deg=-6.0)
 FAR_CAMERA = dict(hfov_deg=12.0, altitude_m=20.0, pitch_deg=-2.0)  # timed at 512×640, one thread
 CAMERAS = {"15 m, −6°": CAMERA, "20 m, −2°": FAR_CAMERA}
-VARIANTS = {"first-hit, across 2": dict(texture_hit_across=2.0),
-            "first-hit, min_step 1/16": dict(texture_hit_min_step=0.0625),
-            "first-hit, across 2, min_step 1/16": dict(texture_hit_across=2.0, texture_hit_min_step=0.0625),
-            "first-hit, patch moments (texture_hit_lean)": dict(texture_hit_lean=True),
-            "first-hit, across 1, patch moments": dict(texture_hit_across=1.0, texture_hit_lean=True),
-            "first-hit, across 2, patch moments": dict(texture_hit_across=2.0, texture_hit_lean=True),
-            "first-hit, across 3, patch moments": dict(texture_hit_across=3.0, texture_hit_lean=True)}
+VARIANTS = {"first-hit, one track (texture_hit_tracks=1)": dict(texture_hit_tracks=1.0),
+            "first-hit, no footprint cap (texture_hit_finest=0, min_step 1/64)":
+                dict(texture_hit_finest=0.0, texture_hit_min_step=1 / 64),
+            "first-hit, the sweep's former settings (one track, no cap, min_step 1/64)":
+                dict(texture_hit_tracks=1.0, texture_hit_finest=0.0, texture_hit_min_step=1 / 64),
+            "first-hit, across 2": dict(texture_hit_across=2.0),
+            "first-hit, patch moments (texture_hit_lean)": dict(texture_hit_lean=True)}
 
 
 def load_baseline(path: str):

@@ -1,11 +1,10 @@
 """The first-hit texture (``TableSize(texture_hit="first")``) in the far field: textured against the
 expectation image, by bands of rows, where a pixel's own footprint resolves few or no waves.
 
-Camera: 48×64 px over 12°, a 20 m mast, pitch −2° (the far-field camera of
-pipelines/texture_vs_raytrace.py's "renderer identities": rows from 180 m to the horizon), looking
+Camera: 48×64 px over 12°, a 20 m mast, pitch −2° (rows from 180 m to the horizon), looking
 upwind, LWIR, brightness temperature, no path, no foam, flat earth. Per band of 4 rows: range, view
-zenith, the pixels' along-view footprint R δ / cos θ̂, how many pixels resolve no band even at 0.8 ×
-their footprint ("far"), and textured − expectation: the worst pixel of one realization (seed 11), the
+zenith, the pixels' footprint as the first hit's fade takes it (the side of the square of its area,
+R δ / √cos θ̂), how many pixels resolve no band even at 0.8 × it ("far"), and textured − expectation: the worst pixel of one realization (seed 11), the
 mean and per-pixel standard deviation over ``--seeds`` realizations (their mean is the bias of the
 texture's ensemble mean, its standard error in brackets), for the first hit and, beside it, the
 flat point (the default). Then the second law (sky = the sea's blackbody radiance R_B: every pixel
@@ -46,10 +45,11 @@ def far_field(wind: float, seeds: list[int]) -> None:
     camsn = rs.make_camera(H, W, hfov_deg=HFOV, altitude_m=20.0, pitch_deg=-2.0, batch_size=len(seeds))
     geo = rs.view_geometry(cams1, earth_radius_m=INF)
     sea, rng, vz = geo.is_sea[0], geo.range_m[0].double(), geo.view_zenith[0].double()
-    foot = rng * math.radians(HFOV) / W / torch.cos(vz)
+    foot = rng * math.radians(HFOV) / W / torch.cos(vz).sqrt()  # (the side of the footprint's area: the fade's)
     field = scene(wind, 11).wave_field(1, torch.float64, torch.device("cpu"))
     cov = field.resolved_covariance(torch.where(sea, 0.8 * foot, torch.zeros_like(foot))[None])
-    far = sea & (cov[0][0] + cov[1][0] == 0)
+    # (and not the row the horizon crosses: its sea part lies lower, where footprints resolve waves)
+    far = sea & (cov[0][0] + cov[1][0] == 0) & torch.nn.functional.pad(sea[:-1], (0, 0, 1, 0))
     expct = render(cams1, scene(wind, None), "flat")[0]
     one = {hit: render(cams1, scene(wind, 11), hit)[0] - expct for hit in ("first", "flat")}
     ens = {hit: render(camsn, scene(wind, seeds), hit) - expct for hit in ("first", "flat")}

@@ -72,10 +72,20 @@ __all__ = ["Sweep", "sweep_layout", "sweep_envelope", "running_minimum", "track_
            "centre_element", "pixel_hits", "sample_step", "footprint_fade"]
 
 
-def sample_step(cos_view: Any, step: float, min_step: float, across: float) -> Any:
+def sample_step(cos_view: Any, step: float, min_step: float, across: float, finest: float = 0.0,
+                width: Any = None) -> Any:
     """The sweep's sample spacing [pixels of depression] at a view of zenith cosine ``cos_view``:
-    ``across`` · cos θ̂ / 2 clamped into [``min_step``, ``step``] (a tensor or a numpy array)."""
+    ``across`` · cos θ̂ / 2 clamped into [``min_step``, ``step``] (a tensor or a numpy array).
+
+    ``finest`` > 0 [m] with ``width`` = R δ [m] (the pixel's width across the view there, of
+    ``cos_view``'s shape): at most ``finest`` · cos θ̂ / (2 R δ), i.e. the samples' footprint along the
+    view (twice the spacing's, 2 s R δ / cos θ̂) at most ``finest`` metres: ``across`` · R δ grows with
+    the range, and near the horizon it would leave unresolved the short waves whose crests still hide
+    what lies behind them (``docs/texture.md`` §13). Still no finer than ``min_step``."""
     half = 0.5 * across * cos_view
+    if finest > 0.0 and width is not None:
+        cap = (0.5 * finest) * cos_view / width
+        half = torch.minimum(half, cap) if isinstance(half, torch.Tensor) else np.minimum(half, cap)
     return half.clip(min_step, step) if hasattr(half, "clip") else min(max(half, min_step), step)
 
 
@@ -144,7 +154,7 @@ class Sweep:
 
 def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, tan_g: torch.Tensor, phi: torch.Tensor,
                  ifov: float, earth_radius_m: float, *, step: float, min_step: float, across: float, tracks: float,
-                 height_sigmas: float = 5.0) -> Sweep | None:
+                 finest: float = 0.0, height_sigmas: float = 5.0) -> Sweep | None:
     """The sweep of one image, or None where its sea pixels resolve no wave.
 
     Args:
@@ -152,8 +162,12 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
         centre: world x, y of the camera [m]; h: its height above the sea [m] (0-D tensor).
         tan_g, phi: the sea pixels' depressions (tangent) and ray azimuths [rad], 1-D.
         ifov: δ, the angular pixel size at the image centre [rad]; earth_radius_m: R [m] (``inf``: flat).
-        step, min_step, across: the samples' spacing in depression, in pixels (:func:`sample_step`);
-            tracks: tracks per pixel width.
+        step, min_step, across, finest: the samples' spacing in depression, in pixels, and the cap on
+            their footprint [m] (:func:`sample_step`); tracks: tracks per pixel width (with a whole number
+            n ≥ 2 of them, the tracks start (n − 1)/2 spacings before the least azimuth and end as far
+            beyond the largest: the n tracks across every pixel exist, and across a pixel whose centre
+            lies on the grid of the least azimuth, φ_min + k δ, they sit at its centre + (q − (n − 1)/2)
+            δ/n, not on rounding ties; :func:`~roughsea_torch.renderer.swept.pixel_tracks`).
         height_sigmas: the resolved elevation's bound, in its standard deviations (the sweep starts where
             the steepest ray may first meet a crest).
     """
@@ -175,7 +189,8 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     # k(γ) = ∫ dγ / (s δ) on a fine grid, inverted at whole k
     g_far, g_near = math.atan(hf / r1), math.atan(hf / r0)
     grid = np.linspace(g_far, g_near, 20001)
-    dk = 1.0 / (ifov * sample_step(np.sin(grid), step, min_step, across))
+    width = hf / np.sin(grid) * ifov  # R δ [m] at each depression (flat sea)
+    dk = 1.0 / (ifov * sample_step(np.sin(grid), step, min_step, across, finest, width))
     k_of_g = np.concatenate([[0.0], np.cumsum(0.5 * (dk[1:] + dk[:-1]) * np.diff(grid))])
     ns = int(math.ceil(k_of_g[-1])) + 1
     if ns < 2:
@@ -185,6 +200,8 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     ph = phi.detach()
     p0, p1 = float(ph.min()), float(ph.max())
     dphi = ifov / tracks
+    wide = 0.5 * (max(1, int(math.floor(tracks + 1e-9))) - 1) * dphi  # (see tracks above)
+    p0, p1 = p0 - wide, p1 + wide
     nt = int(math.ceil((p1 - p0) / dphi)) + 1
     az = p0 + dphi * torch.arange(nt, dtype=dtype, device=device)
     cen = centre.to(dtype)
@@ -193,7 +210,8 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     else:  # (the products' own arrays: c + r cos φ = r cos φ + c)
         x, y = (r[:, None] * torch.cos(az)[None, :]).add_(cen[0]), (r[:, None] * torch.sin(az)[None, :]).add_(cen[1])
     rho = torch.sqrt(r * r + hf * hf)
-    scale = 2.0 * torch.as_tensor(sample_step(np.sin(gam), step, min_step, across), dtype=dtype, device=device)
+    scale = 2.0 * torch.as_tensor(sample_step(np.sin(gam), step, min_step, across, finest, hf / np.sin(gam) * ifov),
+                                  dtype=dtype, device=device)
     fp = footprint(rho, hf / rho, ifov * scale)
     return Sweep(r, az, x, y, fp, h.to(dtype), curv, p0, dphi, eta_max)
 

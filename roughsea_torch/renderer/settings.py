@@ -89,15 +89,19 @@ class TableSize:
             visible-slope distribution (:func:`~roughsea_torch.clutter.visible_slope`; its ensemble
             mean is the expectation image exactly, but near grazing it has neither parallax nor
             hiding). The table method's setting; ``method="direct"`` evaluates the flat point per pixel.
-        texture_hit_step, texture_hit_min_step, texture_hit_across, texture_hit_tracks: the sweep of
-            ``texture_hit="first"``: its samples' spacing in depression [pixels], ``across`` · cos θ̂/2
-            clamped into [``min_step``, ``step``] (each sample filtered at twice its spacing's footprint
-            along the view: near grazing the waves down to ``across`` times the pixel's width across
-            the view; :func:`~roughsea_torch.renderer.hits.sample_step`), and its ground tracks per
-            pixel width. Defaults 1/4, 1/64, 0.7, 1: against a ray trace of the same waves at 80–88.5°
-            they bring σ within 0.85–1.2 in 25 of 29 bins (28 with ``SeaScene(shadowing="correlated")``, 27
-            with "multiscale")
-            where 1/32 and 1 gave 23 (24), at 1.3–1.8× the time (``docs/texture.md`` §11).
+        texture_hit_step, texture_hit_min_step, texture_hit_across, texture_hit_finest, texture_hit_tracks:
+            the sweep of ``texture_hit="first"``: its samples' spacing in depression [pixels],
+            ``across`` · cos θ̂/2 clamped into [``min_step``, ``step``] and at most ``finest`` · cos θ̂ /
+            (2 R δ) (each sample filtered at twice its spacing's footprint along the view: near grazing
+            the waves down to ``across`` times the pixel's width across the view, and down to ``finest``
+            metres where that width has grown beyond it; 0: no such cap;
+            :func:`~roughsea_torch.renderer.hits.sample_step`), and its ground tracks per pixel width
+            (with n = ⌊tracks⌋ ≥ 2 a pixel averages the n tracks across its width, a box across the
+            view as a camera's pixel is; 1: the track through its centre). Defaults 1/4, 1/512, 0.7,
+            0.15 m, 2: against a ray trace of the same waves at 80–88.5° (two realizations, 5–15 m/s,
+            upwind and crosswind, ``SeaScene(shadowing="multiscale")``) σ within 0.85–1.2 in 30 and 30
+            of 30 bins, the ensemble mean within 0.05 K in 30 and 30, where the former defaults (1/64,
+            no cap, one track) gave 28 and 26, 28 and 27, at about 3× their time (``docs/texture.md`` §11).
         texture_hit_visibility: in (0, 1]: the factor on the sweep's sample footprint F_s of the
             elevation its running horizon (the visibility) is taken on; its spacings (step, min_step,
             across) are scaled by it, while the slopes, crest, texture and foam stay filtered at F_s
@@ -184,9 +188,10 @@ class TableSize:
     texture_hit: str = "flat"
     texture_antialias: bool = True
     texture_hit_step: float = 0.25
-    texture_hit_min_step: float = 0.015625
+    texture_hit_min_step: float = 0.001953125
     texture_hit_across: float = 0.7
-    texture_hit_tracks: float = 1.0
+    texture_hit_tracks: float = 2.0
+    texture_hit_finest: float = 0.15
     texture_hit_visibility: float = 1.0
     texture_hit_cross: bool = True
     texture_hit_lean: bool = False
@@ -226,7 +231,8 @@ class TableSize:
         for name, lo, hi in (("texture_steep_zenith_deg", 0.0, 90.0), ("texture_quadrature_width", 1.0, 40.0),
                              ("texture_hit_step", 0.01, 1.0), ("texture_hit_min_step", 0.001, 1.0),
                              ("texture_hit_across", 0.1, 100.0), ("texture_hit_tracks", 0.25, 16.0),
-                             ("texture_hit_visibility", 0.125, 1.0), ("texture_hit_lean_across", 0.05, 4.0)):
+                             ("texture_hit_visibility", 0.125, 1.0), ("texture_hit_lean_across", 0.05, 4.0),
+                             ("texture_hit_finest", 0.0, 100.0)):
             v = getattr(self, name)
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, Real) or not lo <= float(v) <= hi:
                 raise ValueError(f"TableSize.{name} must be a number in [{lo:g}, {hi:g}]; got {v!r}")

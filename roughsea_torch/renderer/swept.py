@@ -27,7 +27,7 @@ from .hits import (Sweep, covers, flat_nonzero, footprint_fade, nonzero_2d, pixe
 from .lean import ELL_CLAMP, ShortWaveMoments, projected_area, weighted_window
 from .path import path_rows
 
-__all__ = ["SweptTexture", "facet_cosine"]
+__all__ = ["SweptTexture", "facet_cosine", "pixel_tracks"]
 
 FOAM_NODES = 1025  # nodes in cos θ of the foam's radiance per image (TableSize.texture_hit_foam_tilt)
 
@@ -62,7 +62,10 @@ class SweptTexture:
             wf = self.field(slice(im, im + 1))
             R = slant_range(cos_t[i][s], h[i], self.earth_radius_m)
             L = footprint(R, cos_t[i][s], self.ifov[im])
-            g = footprint_fade(wf, 0, L)
+            # (the fade at the side of the square of the pixel's footprint's area, R δ / √cos θ̂: near
+            # grazing its footprint is R δ across, far shorter than along, and still resolves the waves whose
+            # crests run along the view)
+            g = footprint_fade(wf, 0, L * cos_t[i][s].clamp_min(1e-9).sqrt())
             rho = torch.sqrt(dx[i] * dx[i] + dy[i] * dy[i]).clamp_min(1e-30)
             tan_g, phi = (-dz[i] / rho)[s], torch.atan2(dy[i], dx[i])[s]
             sw = None
@@ -78,12 +81,24 @@ class SweptTexture:
             if sw is None:
                 continue
             tau_t, tau_b = pixel_windows(tan_g, float(self.ifov[im]))
-            j = ((phi.detach() - sw.p0) / sw.dphi).round().clamp(0, sw.az.shape[0] - 1).long()
-            sw, m = self._swept_envelope(im, wf, sw, j, tau_t, g)
+            # each pixel's tracks: the nearest (its centre ray's), and with n > 1 tracks per pixel width the n
+            # tracks across its width, whose averages it takes (a box across the view)
+            j, n = pixel_tracks(phi, sw, self.hit_tracks)
+            j_all, tt_all, tb_all = ((j, tau_t, tau_b) if n == 1 else
+                                     (torch.cat(j), tau_t.repeat(n + 1), tau_b.repeat(n + 1)))
+            sw, m = self._swept_envelope(im, wf, sw, j_all, tt_all, g.repeat(len(j_all) // g.numel()))
             on = flat_nonzero(g.detach() > 0)  # (the pixels that take the sweep's texture)
-            window = track_windows(sw.shape[1], j.index_select(0, on), tau_t.index_select(0, on), tau_b.index_select(0, on))
+            on_all = on if n == 1 else torch.cat([on + q * g.numel() for q in range(n + 1)])
+            window = track_windows(sw.shape[1], j_all.index_select(0, on_all), tt_all.index_select(0, on_all),
+                                   tb_all.index_select(0, on_all))
             values, x_k, cov_k = self._swept_samples(im, i, wf, sw, m, window, vol, lo, span_z, a, b, coordinate, crest)
-            avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g, overwrite=True)
+            if n == 1:
+                avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g, overwrite=True)
+            else:  # (one search for every track of every pixel; the centre ray on the nearest track)
+                avg, k, hit = pixel_hits(m, values, j_all, tt_all, tb_all, tan_g.repeat(n + 1), overwrite=True)
+                P = tan_g.numel()
+                k, hit, j = k[:P], hit[:P], j[0]
+                avg = avg[:, P:].reshape(avg.shape[0], n, P).mean(1)
             # (with the patch moments: the weighted average over the window's covered part, times that part)
             tex = weighted_window(avg[0], avg[-2], avg[-1]) if self.lean else avg[0]
             texture[i] = texture[i].index_put((s,), g * tex)
@@ -298,6 +313,20 @@ class SweptTexture:
         # slope, docs/texture.md §7) by κ μ
         shift = kappa / lam
         return shift * mx, shift * my, ell, w
+
+
+def pixel_tracks(phi: torch.Tensor, sw: Sweep, tracks: float) -> tuple[Any, int]:
+    """(j, n): the tracks of pixels whose centre rays have azimuths ``phi`` (P,) [rad] on the sweep ``sw``
+    (its tracks ``tracks`` per pixel width). n = ⌊tracks⌋ (at least 1); with n = 1, j (P,) the nearest
+    track; with n > 1, a list: the nearest, then the n tracks nearest the centre at offsets
+    −(n − 1)/2 … (n − 1)/2 track spacings, which span the pixel's width evenly."""
+    n = max(1, int(math.floor(tracks + 1e-9)))
+    u = (phi.detach() - sw.p0) / sw.dphi
+    last = sw.az.shape[0] - 1
+    near = u.round().clamp(0, last).long()
+    if n == 1:
+        return near, 1
+    return [near] + [(u + (q - 0.5 * (n - 1))).round().clamp(0, last).long() for q in range(n)], n
 
 
 def _across_quantile(slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple, dx: torch.Tensor, dy: torch.Tensor,

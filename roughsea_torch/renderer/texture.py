@@ -115,7 +115,7 @@ class TextureTable(SweptTexture):
         # the sweep (TableSize.texture_hit_*): samples s(θ̂) pixels apart in depression, each filtered at
         # twice its spacing's footprint along the view, and the volume built for those footprints
         self.hit_steps = dict(step=float(table.texture_hit_step), min_step=float(table.texture_hit_min_step),
-                              across=float(table.texture_hit_across))
+                              across=float(table.texture_hit_across), finest=float(table.texture_hit_finest))
         self.hit_tracks = float(table.texture_hit_tracks)
         # the layout the running horizon is built on: spacings × v, the elevation at v · F_s; the node
         # values read at every visible sample with the footprint F_s = its footprint / v
@@ -124,10 +124,11 @@ class TextureTable(SweptTexture):
         self.scaled = False  # whether some resolved slopes were scaled down (reconcile_scale)
         self.eq7_vanishing = False  # whether Eq. 7's projected area vanished at some node (warn_eq7)
 
-    def _scale(self, cos_view: torch.Tensor) -> Any:
+    def _scale(self, cos_view: torch.Tensor, width: torch.Tensor) -> Any:
         """The footprint of the texture's nodes, in whole pixels' along-view footprints: 1, or with the
-        sweep twice its sample spacing at that view (:func:`~roughsea_torch.renderer.hits.sample_step`)."""
-        return 2.0 * sample_step(cos_view, **self.hit_steps) if self.first_hit else 1.0
+        sweep twice its sample spacing at that view (:func:`~roughsea_torch.renderer.hits.sample_step`;
+        ``width`` = R δ [m] there)."""
+        return 2.0 * sample_step(cos_view, **self.hit_steps, width=width) if self.first_hit else 1.0
 
     def field(self, sl: slice) -> Any:
         """The wave field of images ``sl``."""
@@ -198,7 +199,8 @@ class TextureTable(SweptTexture):
         th_nodes = torch.acos((self.eps[sl][:, None] * torch.sinh(zeta)).clamp(0.0, 1.0)).to(dtype)
         h = self.altitude[sl].to(dtype)
         cos_n = torch.cos(th_nodes)
-        L = footprint(slant_range(cos_n, h[:, None], self.earth_radius_m), cos_n, self.ifov[sl, None] * self._scale(cos_n))
+        R = slant_range(cos_n, h[:, None], self.earth_radius_m)
+        L = footprint(R, cos_n, self.ifov[sl, None] * self._scale(cos_n, R * self.ifov[sl, None]))
         cov, _ = self.resolved(wf, L, sl)
         cov = tuple(c[:, :, None] for c in cov)  # (b, nz, 1)
         phw = ph_nodes + p.wind_direction[sl, None].to(dtype)  # LOS azimuth in the world
