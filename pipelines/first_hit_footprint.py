@@ -40,8 +40,8 @@ def patch(fp_min_step: float, fp_across: float | None = None) -> None:
     """Filter the sweep's samples (and the volume's nodes) with the floor ``fp_min_step`` [px] and, if
     given, ``fp_across`` in place of ``across`` (the spacing keeps the table's settings)."""
 
-    def fp_step(cos_view, step, min_step, across):
-        return hits.sample_step(cos_view, step, min(fp_min_step, min_step), fp_across or across)
+    def fp_step(cos_view, step, min_step, across, finest=0.0, width=None):
+        return hits.sample_step(cos_view, step, min(fp_min_step, min_step), fp_across or across, finest, width)
 
     def layout(field, image, centre, h, tan_g, phi, ifov, earth_radius_m, *, step, min_step, across, tracks, **kw):
         sw = ORIGINAL_LAYOUT(field, image, centre, h, tan_g, phi, ifov, earth_radius_m, step=step, min_step=min_step,
@@ -50,11 +50,12 @@ def patch(fp_min_step: float, fp_across: float | None = None) -> None:
             hf = float(h.detach())
             rho = torch.sqrt(sw.r * sw.r + hf * hf)
             cos_v = hf / rho  # the flat sea's cos θ̂ at each sample, as sweep_layout takes it
-            sw.footprint = footprint(rho, cos_v, ifov * 2.0 * fp_step(cos_v, step, min_step, across))
+            sw.footprint = footprint(rho, cos_v, ifov * 2.0 * fp_step(cos_v, step, min_step, across,
+                                                                      kw.get("finest", 0.0), rho * ifov))
         return sw
 
-    def scale(self, cos_view):
-        return 2.0 * fp_step(cos_view, **self.hit_steps) if self.first_hit else 1.0
+    def scale(self, cos_view, width):
+        return 2.0 * fp_step(cos_view, **self.hit_steps, width=width) if self.first_hit else 1.0
 
     sx.sweep_layout = layout
     tx.TextureTable._scale = scale

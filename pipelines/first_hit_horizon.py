@@ -75,7 +75,8 @@ def main() -> None:
                 rows = [r for r in range(sea.shape[0]) if bool(sea[r].any()) and bool(same[r][sea[r]].all())]
                 deepest = max((float(dep[r]) for r in rows), default=float("nan"))
                 horizon = float(dep[[r for r in range(sea.shape[0]) if bool(sea[r].any())][0]])
-                band_rows.append(f"| {wind:g} m/s | {deepest - horizon:.2f}° (to {deepest:.2f}° below the horizontal) |")
+                band_rows.append(f"| {wind:g} m/s | {deepest - horizon:.2f}° (to {deepest:.2f}° below the horizontal) |"
+                                 if rows else f"| {wind:g} m/s | none: clutter up to the horizon's row |")
         for label, vals in cells:
             mean_rows.append(f"| {wind:g} m/s | {label} | " + " | ".join(f"{v:+.3f}" for v in vals) + " |")
         bare = render(one, wind, [1], False)[0]

@@ -127,7 +127,9 @@ def identities(fields: dict) -> dict:
     sea = geo.is_sea[0]
     cos_t = torch.cos(geo.view_zenith[0].double())
     foot = geo.range_m[0].double() * math.radians(tvr.HFOV) / tvr.W / cos_t
-    step = 2.0 * sample_step(cos_t, table.texture_hit_step, table.texture_hit_min_step, table.texture_hit_across)
+    width = geo.range_m[0].double() * math.radians(tvr.HFOV) / tvr.W  # R δ [m]
+    step = 2.0 * sample_step(cos_t, table.texture_hit_step, table.texture_hit_min_step, table.texture_hit_across,
+                             table.texture_hit_finest, width)
     out = {}
     for wind in (5.0, 15.0):
         diff = (tvr.render(cams, tvr.scene(wind, 0.0, tvr.SEED)) - tvr.render(cams, tvr.scene(wind, 0.0, None)))[0, 0]

@@ -163,8 +163,8 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
         tan_g, phi: the sea pixels' depressions (tangent) and ray azimuths [rad], 1-D.
         ifov: δ, the angular pixel size at the image centre [rad]; earth_radius_m: R [m] (``inf``: flat).
         step, min_step, across, finest: the samples' spacing in depression, in pixels, and the cap on
-            their footprint [m] (:func:`sample_step`); tracks: tracks per pixel width (with a whole number
-            n ≥ 2 of them, the tracks start (n − 1)/2 spacings before the least azimuth and end as far
+            their footprint [m] (:func:`sample_step`); tracks: tracks per pixel width (with n = ⌊tracks⌋
+            ≥ 2, n of them, the tracks start (n − 1)/2 spacings before the least azimuth and end as far
             beyond the largest: the n tracks across every pixel exist, and across a pixel whose centre
             lies on the grid of the least azimuth, φ_min + k δ, they sit at its centre + (q − (n − 1)/2)
             δ/n, not on rounding ties; :func:`~roughsea_torch.renderer.swept.pixel_tracks`).
@@ -199,8 +199,9 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     r = torch.as_tensor(hf / np.tan(gam), dtype=dtype, device=device)
     ph = phi.detach()
     p0, p1 = float(ph.min()), float(ph.max())
-    dphi = ifov / tracks
-    wide = 0.5 * (max(1, int(math.floor(tracks + 1e-9))) - 1) * dphi  # (see tracks above)
+    n = max(1, int(math.floor(tracks + 1e-9)))
+    dphi = ifov / (tracks if n == 1 else n)
+    wide = 0.5 * (n - 1) * dphi  # (see tracks above)
     p0, p1 = p0 - wide, p1 + wide
     nt = int(math.ceil((p1 - p0) / dphi)) + 1
     az = p0 + dphi * torch.arange(nt, dtype=dtype, device=device)

@@ -96,8 +96,9 @@ class TableSize:
             the waves down to ``across`` times the pixel's width across the view, and down to ``finest``
             metres where that width has grown beyond it; 0: no such cap;
             :func:`~roughsea_torch.renderer.hits.sample_step`), and its ground tracks per pixel width
-            (with n = ⌊tracks⌋ ≥ 2 a pixel averages the n tracks across its width, a box across the
-            view as a camera's pixel is; 1: the track through its centre). Defaults 1/4, 1/512, 0.7,
+            (with n = ⌊tracks⌋ ≥ 2 a pixel averages the n tracks across its width, δ/n apart, a box
+            across the view as a camera's pixel is, and the glint takes the mean of its centre ray's
+            first hits on them; 1: the track through its centre). Defaults 1/4, 1/512, 0.7,
             0.15 m, 2: against a ray trace of the same waves at 80–88.5° (two realizations, 5–15 m/s,
             upwind and crosswind, ``SeaScene(shadowing="multiscale")``) σ within 0.85–1.2 in 30 and 30
             of 30 bins, the ensemble mean within 0.05 K in 30 and 30, where the former defaults (1/64,

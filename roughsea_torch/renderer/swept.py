@@ -81,24 +81,23 @@ class SweptTexture:
             if sw is None:
                 continue
             tau_t, tau_b = pixel_windows(tan_g, float(self.ifov[im]))
-            # each pixel's tracks: the nearest (its centre ray's), and with n > 1 tracks per pixel width the n
-            # tracks across its width, whose averages it takes (a box across the view)
+            # each pixel's n tracks across its width (one: the nearest), all pixels' n blocks in one: the
+            # window averages, and the centre ray's first hit on each, are the means over its n tracks
             j, n = pixel_tracks(phi, sw, self.hit_tracks)
-            j_all, tt_all, tb_all = ((j, tau_t, tau_b) if n == 1 else
-                                     (torch.cat(j), tau_t.repeat(n + 1), tau_b.repeat(n + 1)))
-            sw, m = self._swept_envelope(im, wf, sw, j_all, tt_all, g.repeat(len(j_all) // g.numel()))
-            on = flat_nonzero(g.detach() > 0)  # (the pixels that take the sweep's texture)
-            on_all = on if n == 1 else torch.cat([on + q * g.numel() for q in range(n + 1)])
-            window = track_windows(sw.shape[1], j_all.index_select(0, on_all), tt_all.index_select(0, on_all),
-                                   tb_all.index_select(0, on_all))
+            P = tan_g.numel()
+            rep = (lambda v: v) if n == 1 else (lambda v: v.repeat(n))  # noqa: E731
+            tt_all, tb_all, g_all = rep(tau_t), rep(tau_b), rep(g)
+            sw, m = self._swept_envelope(im, wf, sw, j, tt_all, g_all)
+            on = flat_nonzero(g_all.detach() > 0)  # (the pixels' tracks that take the sweep's texture)
+            window = track_windows(sw.shape[1], j.index_select(0, on), tt_all.index_select(0, on), tb_all.index_select(0, on))
             values, x_k, cov_k = self._swept_samples(im, i, wf, sw, m, window, vol, lo, span_z, a, b, coordinate, crest)
-            if n == 1:
-                avg, k, hit = pixel_hits(m, values, j, tau_t, tau_b, tan_g, overwrite=True)
-            else:  # (one search for every track of every pixel; the centre ray on the nearest track)
-                avg, k, hit = pixel_hits(m, values, j_all, tt_all, tb_all, tan_g.repeat(n + 1), overwrite=True)
-                P = tan_g.numel()
-                k, hit, j = k[:P], hit[:P], j[0]
-                avg = avg[:, P:].reshape(avg.shape[0], n, P).mean(1)
+            avg, k, hit = pixel_hits(m, values, j, tt_all, tb_all, rep(tan_g), overwrite=True)
+            # (x = 0 where g = 0: the pixel resolves nothing, its resolved covariance g² C is 0 too)
+            x_h = torch.where(hit & (g_all.detach() > 0), read_at(*x_k, k * sw.shape[1] + j), torch.zeros_like(g_all))
+            cov_h = [cov_k[c][k] for c in range(3)]
+            if n > 1:
+                avg = avg.reshape(avg.shape[0], n, P).mean(1)
+                x_h, cov_h = x_h.reshape(n, P).mean(0), [c.reshape(n, P).mean(0) for c in cov_h]
             # (with the patch moments: the weighted average over the window's covered part, times that part)
             tex = weighted_window(avg[0], avg[-2], avg[-1]) if self.lean else avg[0]
             texture[i] = texture[i].index_put((s,), g * tex)
@@ -107,11 +106,9 @@ class SweptTexture:
                     f_pix[c][i] = f_pix[c][i].index_put((s,), flat[c] + g * avg[1 + c])
                 if self.foam_tilt:
                     f_pix[2][i] = f_pix[2][i].index_put((s,), g * avg[3])
-            # (x = 0 where g = 0: the pixel resolves nothing, its resolved covariance g² C is 0 too)
-            x_c[i] = x_c[i].index_put((s,), torch.where(hit & (g.detach() > 0), read_at(*x_k, k * sw.shape[1] + j),
-                                                         torch.zeros_like(tan_g)))
+            x_c[i] = x_c[i].index_put((s,), x_h)
             for c in range(3):  # (g² C: the glint's resolved part fades with the texture)
-                cov_c[c][i] = cov_c[c][i].index_put((s,), g * g * cov_k[c][k])
+                cov_c[c][i] = cov_c[c][i].index_put((s,), g * g * cov_h[c])
         return texture, (x_c, x_c), tuple(cov_c), f_pix
 
     def _flat_covers(self, im: int, wf: Any, R: torch.Tensor, L: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor,
@@ -184,7 +181,10 @@ class SweptTexture:
         t0 = sw.flat_depression()
         cos_k = torch.sin(torch.atan(t0) + 2.0 * sw.curv * sw.r).clamp(1e-9, 1.0)
         zeta_k = torch.asinh(cos_k.double() / self.eps[im]).to(dtype)
-        gy_k = (2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) / (1.0 + self.ez)
+        # (within the nodes' range in ζ: samples beyond the pixels' rows read its edge, not the fine grid's
+        # overhang, where the nodes' polynomial is extrapolated)
+        lim = 1.0 / (1.0 + self.ez)
+        gy_k = ((2.0 * (zeta_k - lo[i].to(dtype)) / span_z[i].to(dtype) - 1.0) * lim).clamp(-lim, lim)
         o_t = coordinate(cx[None, None, :], sx[None, None, :], i)
         lean = (self._lean_samples(im, wf, sw, fpk, cov_k, Xv[0], Yv[0], row, col, smp["slope_x"][0], smp["slope_y"][0],
                                    cos_k) if self.lean else None)
@@ -315,18 +315,18 @@ class SweptTexture:
         return shift * mx, shift * my, ell, w
 
 
-def pixel_tracks(phi: torch.Tensor, sw: Sweep, tracks: float) -> tuple[Any, int]:
+def pixel_tracks(phi: torch.Tensor, sw: Sweep, tracks: float) -> tuple[torch.Tensor, int]:
     """(j, n): the tracks of pixels whose centre rays have azimuths ``phi`` (P,) [rad] on the sweep ``sw``
-    (its tracks ``tracks`` per pixel width). n = ⌊tracks⌋ (at least 1); with n = 1, j (P,) the nearest
-    track; with n > 1, a list: the nearest, then the n tracks nearest the centre at offsets
-    −(n − 1)/2 … (n − 1)/2 track spacings, which span the pixel's width evenly."""
+    (``tracks`` per pixel width, :func:`~roughsea_torch.renderer.hits.sweep_layout`). n = ⌊tracks⌋ (at
+    least 1); with n = 1, j (P,) the nearest track; with n > 1, j (n P,): for q = 0 … n − 1 the block of
+    every pixel's track at its centre + (q − (n − 1)/2) δ/n, n tracks spanning its width evenly (the
+    midpoint rule of a box δ wide)."""
     n = max(1, int(math.floor(tracks + 1e-9)))
     u = (phi.detach() - sw.p0) / sw.dphi
     last = sw.az.shape[0] - 1
-    near = u.round().clamp(0, last).long()
     if n == 1:
-        return near, 1
-    return [near] + [(u + (q - 0.5 * (n - 1))).round().clamp(0, last).long() for q in range(n)], n
+        return u.round().clamp(0, last).long(), 1
+    return torch.cat([(u + (q - 0.5 * (n - 1))).round().clamp(0, last).long() for q in range(n)]), n
 
 
 def _across_quantile(slope_x: torch.Tensor, slope_y: torch.Tensor, cov: tuple, dx: torch.Tensor, dy: torch.Tensor,

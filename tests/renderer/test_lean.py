@@ -160,9 +160,10 @@ def test_patch_moments_bring_light_wind_clutter_towards_the_ray_trace():
     moments gain at least 0.065 of it and stay below 1.2, and the mean per-pixel correlation with the
     trace gains at least 0.05 (measured 0.720 → 0.843, correlation 0.824 → 0.979). The defaults since
     2026-11-27 (two tracks across each pixel, samples' footprint at most 0.15 m) resolve those waves
-    instead: σ within 0.85–1.2 and correlation ≥ 0.95 without the patch moments (measured 0.942 and
+    instead: σ within 0.9–1.2 and correlation ≥ 0.95 without the patch moments (measured 0.942 and
     1.03; with them 0.934 and 1.03, which is why they stay off). Planted on the defaults, one track per
-    pixel: σ 1.13 but correlation 0.865; no cap: σ 0.687; each fails. (Planted before, on the former
+    pixel: σ 1.13 but correlation 0.865; no cap: σ 0.69–0.71; the fade at the along-view footprint R δ /
+    cos θ̂ (not the side of its area): σ 0.849; each fails. (Planted before, on the former
     settings: the mean alone (ℓ = 0), the variance alone (μ = 0), ℓ clamped to ±0.05 each gave about
     half the gain, neither no gain.)"""
     seeds = [23, 11, 5, 7]
@@ -184,7 +185,7 @@ def test_patch_moments_bring_light_wind_clutter_towards_the_ray_trace():
         corr[name] = float(((a * b).mean((1, 2)) / (var * var_ray).sqrt()).mean())
     assert ratio["former"] < 0.8 and ratio["former"] + 0.065 < ratio["former, lean"] < 1.2, ratio
     assert corr["former, lean"] >= corr["former"] + 0.05, corr
-    assert 0.85 < ratio["default"] < 1.2 and corr["default"] >= 0.95, (ratio, corr)
+    assert 0.9 < ratio["default"] < 1.2 and corr["default"] >= 0.95, (ratio, corr)
 
 
 def test_patch_moments_weighted_by_their_visible_area_keep_the_ensemble_mean():
