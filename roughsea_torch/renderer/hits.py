@@ -65,6 +65,7 @@ import numpy as np
 import torch
 
 from ..clutter import footprint
+from ..geometry import slant_range
 from ..wave_bands import band_window
 
 __all__ = ["Sweep", "sweep_layout", "sweep_envelope", "running_minimum", "track_windows", "covers", "visible_samples",
@@ -210,10 +211,18 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
         x, y = cen[0] + r[:, None] * torch.cos(az)[None, :], cen[1] + r[:, None] * torch.sin(az)[None, :]
     else:  # (the products' own arrays: c + r cos φ = r cos φ + c)
         x, y = (r[:, None] * torch.cos(az)[None, :]).add_(cen[0]), (r[:, None] * torch.sin(az)[None, :]).add_(cen[1])
-    rho = torch.sqrt(r * r + hf * hf)
-    scale = 2.0 * torch.as_tensor(sample_step(np.sin(gam), step, min_step, across, finest, hf / np.sin(gam) * ifov),
-                                  dtype=dtype, device=device)
-    fp = footprint(rho, hf / rho, ifov * scale)
+    if curv == 0.0:
+        rho = torch.sqrt(r * r + hf * hf)
+        scale = 2.0 * torch.as_tensor(sample_step(np.sin(gam), step, min_step, across, finest, hf / np.sin(gam) * ifov),
+                                      dtype=dtype, device=device)
+        fp = footprint(rho, hf / rho, ifov * scale)
+    else:  # (the footprint of the volume's row the sample reads, TextureTable._scale: its view zenith cos θ̂ with the
+        # local vertical tilted by r/R, its slant range on the curved sea)
+        rn = hf / np.tan(gam)
+        cos_k = torch.as_tensor(np.clip(np.sin(np.arctan((hf + curv * rn * rn) / rn) + 2.0 * curv * rn), 1e-9, 1.0),
+                                dtype=dtype, device=device)
+        R_k = slant_range(cos_k, torch.tensor(hf, dtype=dtype, device=device), earth_radius_m)
+        fp = footprint(R_k, cos_k, ifov * 2.0 * sample_step(cos_k, step, min_step, across, finest, R_k * ifov))
     return Sweep(r, az, x, y, fp, h.to(dtype), curv, p0, dphi, eta_max)
 
 

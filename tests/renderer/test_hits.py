@@ -13,9 +13,12 @@ import torch
 import roughsea_torch as rs
 from roughsea_torch.raytrace import raytraced_image
 from roughsea_torch._parallel import in_blocks
+from roughsea_torch.clutter import footprint
+from roughsea_torch.geometry import slant_range
 from roughsea_torch.renderer.hits import (Sweep, centre_element, covers, footprint_fade, nonzero_2d, pixel_hits,
-                                          pixel_windows, read_at, sample_step, sweep_envelope, visible_average,
-                                          visible_samples)
+                                          pixel_windows, read_at, sample_step, sweep_envelope, sweep_layout,
+                                          visible_average, visible_samples)
+from roughsea_torch.renderer.swept import pixel_tracks
 
 F64 = torch.float64
 H_CAM = 10.0
@@ -318,9 +321,6 @@ def test_a_pixels_tracks_span_its_width_evenly(n):
     would be rounding ties) and for the pixel at φ_min itself. Planted, the tracks not started (n − 1)/2 spacings before φ_min
     (sweep_layout): n = 2 rounds both of a pixel's tracks to one (or to its edges), n = 3 and 4 clamp
     the first pixel's left tracks, and every case fails."""
-    from roughsea_torch.renderer.hits import sweep_layout
-    from roughsea_torch.renderer.swept import pixel_tracks
-
     wf = rs.SeaScene(wind_speed=10.0, sea_temperature=290.0, seed=1).wave_field(1, F64, torch.device("cpu"))
     ifov = 1e-3
     phi = torch.cat([0.3 + ifov * torch.arange(12, dtype=F64),  # centres on the grid of the least azimuth
@@ -367,6 +367,28 @@ def test_a_pixels_tracks_are_the_mean_of_one_track_renders_of_turned_cameras(n):
     turned = sum(texture((q - 0.5 * (n - 1)) * delta / n, 1.0) for q in range(n)) / n
     assert float((box - turned).abs().max()) < 3e-3 * float(box.std()), (float((box - turned).abs().max()), float(box.std()))
     assert float((texture(0.0, 1.0) - box).abs().max()) > 0.3 * float(box.std())  # (the box is not the line)
+
+
+@pytest.mark.parametrize("earth_radius", [math.inf, 6.371e6])
+def test_each_sample_is_filtered_at_the_footprint_of_the_volume_row_it_reads(earth_radius):
+    """The sweep's samples read the texture volume at the row of their own view zenith (cos θ̂ with the
+    local vertical tilted by r/R, as ``SweptTexture._swept_samples`` takes it), whose nodes split the
+    waves at the footprint ``footprint(R(cos θ̂), cos θ̂, δ · 2 s(cos θ̂))`` (``TextureTable._scale``): the
+    slopes a sample resolves must be those, on a flat and on a curved Earth, or near the horizon a wave
+    band is counted twice or not at all. Written here from those two rules; equal to 1e-9 over three
+    cameras (15, 20 and 300 m; 0.38°, 0.19° and 0.94° pixels). Planted, the sample's footprint from the
+    flat sea's cos θ̂ on the curved Earth (as before 2026-11-27's evening): up to 20 % off at 15–20 m and
+    4.5× at 300 m (review), and the test fails."""
+    wf = rs.SeaScene(wind_speed=10.0, sea_temperature=290.0, seed=1).wave_field(1, F64, torch.device("cpu"))
+    steps = dict(step=0.25, min_step=1 / 512, across=0.7, finest=0.15)
+    for h, ifov in ((15.0, math.radians(6 / 16)), (20.0, math.radians(12 / 64)), (300.0, math.radians(30 / 32))):
+        tan_g = torch.linspace(0.01, 0.12, 50, dtype=F64)
+        sw = sweep_layout(wf, 0, torch.zeros(2, dtype=F64), torch.tensor(h, dtype=F64), tan_g, torch.zeros(50, dtype=F64),
+                          ifov, earth_radius, tracks=2.0, **steps)
+        cos_k = torch.sin(torch.atan(sw.flat_depression()) + 2.0 * sw.curv * sw.r).clamp(1e-9, 1.0)
+        R = slant_range(cos_k, torch.tensor(h, dtype=F64), earth_radius)
+        node = footprint(R, cos_k, ifov * 2.0 * sample_step(cos_k, **steps, width=R * ifov))
+        torch.testing.assert_close(sw.footprint, node, rtol=1e-9, atol=0)
 
 
 def test_flat_sea_depression_follows_the_earths_curvature():
