@@ -103,7 +103,7 @@ def main() -> None:
         "|---|---|---:|---:|",
         *foam_rows,
         "",
-        f"The band below the horizon without clutter (every seed's pixel equal to the expectation image within 1e-4 K):",
+        "The band below the horizon without clutter (every seed's pixel equal to the expectation image within 1e-4 K):",
         "",
         "| wind | below the horizon |",
         "|---|---|",

@@ -70,7 +70,7 @@ from ..wave_bands import band_window
 
 __all__ = ["Sweep", "sweep_layout", "sweep_envelope", "running_minimum", "track_windows", "covers", "visible_samples",
            "flat_nonzero", "nonzero_2d", "read_at", "pixel_windows", "visible_average",
-           "centre_element", "pixel_hits", "sample_step", "footprint_fade"]
+           "centre_element", "pixel_hits", "sample_step", "footprint_fade", "track_count", "view_cosine"]
 
 
 def sample_step(cos_view: Any, step: float, min_step: float, across: float, finest: float = 0.0,
@@ -108,6 +108,19 @@ def footprint_fade(field: Any, image: int, pixel_footprint: torch.Tensor) -> tor
     return band_window(pixel_footprint, float(min(k)))
 
 
+def track_count(tracks: float) -> int:
+    """n = ⌊``tracks``⌋, at least 1: the tracks a pixel averages across its width (``TableSize.texture_hit_tracks``;
+    with n ≥ 2 they are δ/n apart, :func:`sweep_layout`, :func:`~roughsea_torch.renderer.swept.pixel_tracks`)."""
+    return max(1, int(math.floor(tracks + 1e-9)))
+
+
+def view_cosine(r: torch.Tensor, h: Any, curv: float) -> torch.Tensor:
+    """cos θ̂ of the sea point at horizontal distance ``r`` [m] seen from height ``h`` [m]: the sine of its
+    depression atan((h + r²/(2R))/r) plus the local vertical's tilt r/R (``curv`` = 1/(2R)), clamped into
+    [1e-9, 1]; the view zenith of the volume's row a sample reads."""
+    return torch.sin(torch.atan((h + curv * r * r) / r) + 2.0 * curv * r).clamp(1e-9, 1.0)
+
+
 @dataclass
 class Sweep:
     """One image's sweep: sample distances ``r`` (ns,) [m] and track azimuths ``az`` (nt,) [rad], the
@@ -134,6 +147,10 @@ class Sweep:
     def flat_depression(self) -> torch.Tensor:
         """t0 (ns,): the depression of the flat sea's point at each sample."""
         return (self.h + self.curv * self.r * self.r) / self.r
+
+    def view_cosine(self) -> torch.Tensor:
+        """cos θ̂ (ns,) at each sample (:func:`view_cosine`)."""
+        return view_cosine(self.r, self.h, self.curv)
 
     def until(self, tau: float) -> "Sweep":
         """The sweep's first samples (the same points), up to the first whose depression is ≤ ``tau`` (a
@@ -200,7 +217,7 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
     r = torch.as_tensor(hf / np.tan(gam), dtype=dtype, device=device)
     ph = phi.detach()
     p0, p1 = float(ph.min()), float(ph.max())
-    n = max(1, int(math.floor(tracks + 1e-9)))
+    n = track_count(tracks)
     dphi = ifov / (tracks if n == 1 else n)
     wide = 0.5 * (n - 1) * dphi  # (see tracks above)
     p0, p1 = p0 - wide, p1 + wide
@@ -211,18 +228,12 @@ def sweep_layout(field: Any, image: int, centre: torch.Tensor, h: torch.Tensor, 
         x, y = cen[0] + r[:, None] * torch.cos(az)[None, :], cen[1] + r[:, None] * torch.sin(az)[None, :]
     else:  # (the products' own arrays: c + r cos φ = r cos φ + c)
         x, y = (r[:, None] * torch.cos(az)[None, :]).add_(cen[0]), (r[:, None] * torch.sin(az)[None, :]).add_(cen[1])
-    if curv == 0.0:
-        rho = torch.sqrt(r * r + hf * hf)
-        scale = 2.0 * torch.as_tensor(sample_step(np.sin(gam), step, min_step, across, finest, hf / np.sin(gam) * ifov),
-                                      dtype=dtype, device=device)
-        fp = footprint(rho, hf / rho, ifov * scale)
-    else:  # (the footprint of the volume's row the sample reads, TextureTable._scale: its view zenith cos θ̂ with the
-        # local vertical tilted by r/R, its slant range on the curved sea)
-        rn = hf / np.tan(gam)
-        cos_k = torch.as_tensor(np.clip(np.sin(np.arctan((hf + curv * rn * rn) / rn) + 2.0 * curv * rn), 1e-9, 1.0),
-                                dtype=dtype, device=device)
-        R_k = slant_range(cos_k, torch.tensor(hf, dtype=dtype, device=device), earth_radius_m)
-        fp = footprint(R_k, cos_k, ifov * 2.0 * sample_step(cos_k, step, min_step, across, finest, R_k * ifov))
+    # each sample filtered at the footprint of the volume's row it reads (TextureTable._scale): its view zenith,
+    # the local vertical tilted by r/R, and its slant range on the (curved) sea
+    h_ = h.detach().to(dtype)
+    cos_k = view_cosine(r, h_, curv)
+    R_k = slant_range(cos_k, h_, earth_radius_m)
+    fp = footprint(R_k, cos_k, ifov * 2.0 * sample_step(cos_k, step, min_step, across, finest, R_k * ifov))
     return Sweep(r, az, x, y, fp, h.to(dtype), curv, p0, dphi, eta_max)
 
 

@@ -23,7 +23,7 @@ from ..geometry import slant_range
 from ..whitecaps import whitecap_cover
 from .foam_terms import foam_state_radiances_of_images
 from .hits import (Sweep, covers, flat_nonzero, footprint_fade, nonzero_2d, pixel_hits, pixel_windows, read_at,
-                   sweep_envelope, sweep_layout, track_windows, visible_samples)
+                   sweep_envelope, sweep_layout, track_count, track_windows, visible_samples)
 from .lean import ELL_CLAMP, ShortWaveMoments, projected_area, weighted_window
 from .path import path_rows
 
@@ -85,19 +85,16 @@ class SweptTexture:
             # window averages, and the centre ray's first hit on each, are the means over its n tracks
             j, n = pixel_tracks(phi, sw, self.hit_tracks)
             P = tan_g.numel()
-            rep = (lambda v: v) if n == 1 else (lambda v: v.repeat(n))  # noqa: E731
-            tt_all, tb_all, g_all = rep(tau_t), rep(tau_b), rep(g)
+            tt_all, tb_all, g_all = tau_t.repeat(n), tau_b.repeat(n), g.repeat(n)
             sw, m = self._swept_envelope(im, wf, sw, j, tt_all, g_all)
             on = flat_nonzero(g_all.detach() > 0)  # (the pixels' tracks that take the sweep's texture)
             window = track_windows(sw.shape[1], j.index_select(0, on), tt_all.index_select(0, on), tb_all.index_select(0, on))
             values, x_k, cov_k = self._swept_samples(im, i, wf, sw, m, window, vol, lo, span_z, a, b, coordinate, crest)
-            avg, k, hit = pixel_hits(m, values, j, tt_all, tb_all, rep(tan_g), overwrite=True)
+            avg, k, hit = pixel_hits(m, values, j, tt_all, tb_all, tan_g.repeat(n), overwrite=True)
             # (x = 0 where g = 0: the pixel resolves nothing, its resolved covariance g² C is 0 too)
             x_h = torch.where(hit & (g_all.detach() > 0), read_at(*x_k, k * sw.shape[1] + j), torch.zeros_like(g_all))
-            cov_h = [cov_k[c][k] for c in range(3)]
-            if n > 1:
-                avg = avg.reshape(avg.shape[0], n, P).mean(1)
-                x_h, cov_h = x_h.reshape(n, P).mean(0), [c.reshape(n, P).mean(0) for c in cov_h]
+            avg = avg.reshape(avg.shape[0], n, P).mean(1)
+            x_h, cov_h = x_h.reshape(n, P).mean(0), [cov_k[c][k].reshape(n, P).mean(0) for c in range(3)]
             # (with the patch moments: the weighted average over the window's covered part, times that part)
             tex = weighted_window(avg[0], avg[-2], avg[-1]) if self.lean else avg[0]
             texture[i] = texture[i].index_put((s,), g * tex)
@@ -178,8 +175,7 @@ class SweptTexture:
         cov_k = tuple(c[0] for c in wf.resolved_covariance(fpk[None]))  # 3 of (ns,)
         cx, sx = torch.cos(sw.az), torch.sin(sw.az)  # the tracks' ray directions (camera → sea)
         # each sample's row in the volume: ζ of its flat view zenith (the local vertical tilts by r/R)
-        t0 = sw.flat_depression()
-        cos_k = torch.sin(torch.atan(t0) + 2.0 * sw.curv * sw.r).clamp(1e-9, 1.0)
+        cos_k = sw.view_cosine()
         zeta_k = torch.asinh(cos_k.double() / self.eps[im]).to(dtype)
         # (within the nodes' range in ζ: samples beyond the pixels' rows read its edge, not the fine grid's
         # overhang, where the nodes' polynomial is extrapolated)
@@ -318,14 +314,12 @@ class SweptTexture:
 def pixel_tracks(phi: torch.Tensor, sw: Sweep, tracks: float) -> tuple[torch.Tensor, int]:
     """(j, n): the tracks of pixels whose centre rays have azimuths ``phi`` (P,) [rad] on the sweep ``sw``
     (``tracks`` per pixel width, :func:`~roughsea_torch.renderer.hits.sweep_layout`). n = ⌊tracks⌋ (at
-    least 1); with n = 1, j (P,) the nearest track; with n > 1, j (n P,): for q = 0 … n − 1 the block of
+    least 1, :func:`~roughsea_torch.renderer.hits.track_count`); j (n P,): for q = 0 … n − 1 the block of
     every pixel's track at its centre + (q − (n − 1)/2) δ/n, n tracks spanning its width evenly (the
-    midpoint rule of a box δ wide)."""
-    n = max(1, int(math.floor(tracks + 1e-9)))
+    midpoint rule of a box δ wide; with n = 1 the nearest track)."""
+    n = track_count(tracks)
     u = (phi.detach() - sw.p0) / sw.dphi
     last = sw.az.shape[0] - 1
-    if n == 1:
-        return u.round().clamp(0, last).long(), 1
     return torch.cat([(u + (q - 0.5 * (n - 1))).round().clamp(0, last).long() for q in range(n)]), n
 
 
