@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import platform
 import sys
 from typing import Callable
 
@@ -233,8 +234,23 @@ def render_all() -> dict[str, torch.Tensor]:
 
 
 def stamp() -> dict[str, str]:
-    """What the bits depend on besides the code: torch's build and the CPU kernels it dispatches to."""
-    return {"torch": str(torch.__version__), "cpu_capability": torch.backends.cpu.get_cpu_capability()}
+    """What the bits depend on besides the code: torch's build, the CPU kernels it dispatches to, and the
+    CPU's maker (Intel and AMD processors of the same capability, AVX512, round a few float32 values
+    differently: 1e-5 W m⁻² sr⁻¹, through vendor-specific library paths)."""
+    return {"torch": str(torch.__version__), "cpu_capability": torch.backends.cpu.get_cpu_capability(),
+            "cpu_vendor": _cpu_vendor()}
+
+
+def _cpu_vendor() -> str:
+    """The CPU's vendor_id of /proc/cpuinfo (e.g. GenuineIntel, AuthenticAMD), or platform.processor()."""
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as fh:
+            for line in fh:
+                if line.startswith("vendor_id"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor()
 
 
 def main(argv: list[str] | None = None) -> int:
