@@ -216,12 +216,14 @@ def test_shipped_table_is_the_computed_one():
     """The correlated masking table ships with the package (``data/masking/masking_table.npz``, made by
     ``pipelines/make_masking_table.py``; computing it took ~10 s on every process's first correlated
     render): :func:`masking.masking_table` reads it, on the nodes the module defines, and three of its ν
-    columns (the first, middle and last) equal a fresh computation of the integrals to 1e-12. A stale or
-    damaged file (other nodes, other values) fails here."""
+    columns (the first, middle and last) equal a fresh computation of the integrals to 1e-9. A stale or
+    damaged file (other nodes, other values) fails here. (The same float64 sums on another processor
+    differ: 1.7e-10 between the AMD EPYC that wrote the file and an Intel Xeon, where the file's own
+    machine gave 1e-12.)"""
     assert masking.TABLE_FILE.is_file()
     p, ln_nu, q = masking.masking_table()
     p0, ln0 = masking.table_nodes()
     assert torch.equal(p, p0) and torch.equal(ln_nu, ln0)
     cols = [0, ln_nu.numel() // 2, ln_nu.numel() - 1]
     _, _, fresh = masking.compute_masking_table(rows=cols)
-    assert float((q[:, cols] - fresh).abs().max()) < 1e-12
+    assert float((q[:, cols] - fresh).abs().max()) < 1e-9

@@ -51,7 +51,9 @@ def test_autograd_mode_reaches_the_workers(two_threads):
     (g2,) = torch.autograd.grad(rs.render(_cams(), _scene(wind), chunk=1).sum(), wind)
     torch.set_num_threads(1)
     (g1,) = torch.autograd.grad(rs.render(_cams(), _scene(wind), chunk=1).sum(), wind)
-    assert torch.equal(g1, g2) and bool((g1 != 0).all())
+    # the backward pass runs on the caller's threads, whose reductions split by their count: one ulp
+    # (1.8e-16 relative) between 1 and 2 threads on an Intel Xeon, none on an AMD EPYC
+    assert torch.allclose(g1, g2, rtol=1e-14, atol=0.0) and bool((g1 != 0).all())
 
 
 def test_sensor_runs_on_one_thread_and_restores_the_setting():
